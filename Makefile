@@ -1,0 +1,37 @@
+# Every target wraps the `arachnae` command; `make setup` runs once per machine.
+VENV     := .venv
+PY       := $(VENV)/bin/python
+ARACHNAE := $(VENV)/bin/arachnae
+STAMP    := $(VENV)/.setup-stamp
+
+.PHONY: setup run test codegen codegen-check spec-check check bench clean
+
+setup: $(STAMP)
+
+$(STAMP): pyproject.toml scripts/setup.sh scripts/apt-packages.txt
+	./scripts/setup.sh
+	touch $@
+
+## The main job on the built-in default scenario.
+run: setup
+	$(ARACHNAE) spec check
+	$(ARACHNAE) codegen --check
+	$(ARACHNAE) decode 030122020210aab4
+
+## All tests, as CI runs them.
+test: setup
+	$(ARACHNAE) spec check
+	$(ARACHNAE) codegen --check
+	$(PY) -m pytest
+
+codegen: setup
+	$(ARACHNAE) codegen
+
+spec-check: setup
+	$(ARACHNAE) spec check
+
+bench: setup
+	$(PY) bench/codec_bench.py
+
+clean:
+	rm -rf $(VENV) build *.egg-info .pytest_cache

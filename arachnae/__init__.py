@@ -1,0 +1,1 @@
+"""ARACHNAE II toolkit: the `arachnae` command and what its parts share."""

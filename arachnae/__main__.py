@@ -1,0 +1,3 @@
+from arachnae.cli import main
+
+raise SystemExit(main())

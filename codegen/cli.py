@@ -1,0 +1,94 @@
+"""Subcommands of the spec and its generated code: `spec check`, `spec nodes`, `codegen`, `decode`."""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from arachnae.errors import UserError
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    spec = sub.add_parser("spec", help="check or show the spec")
+    spec_sub = spec.add_subparsers(dest="spec_command", metavar="ACTION", required=True)
+    check = spec_sub.add_parser("check", help="validate spec/nodes.yaml and spec/messages.yaml")
+    check.add_argument("--spec", type=Path, default=None, metavar="DIR", help="spec folder (default: spec/)")
+    check.set_defaults(func=_spec_check)
+    nodes = spec_sub.add_parser("nodes", help="print the node table with buses and masters")
+    nodes.add_argument("--spec", type=Path, default=None, metavar="DIR")
+    nodes.set_defaults(func=_spec_nodes)
+
+    gen = sub.add_parser("codegen", help="generate C, Python and the conformance vectors from the spec")
+    gen.add_argument("--spec", type=Path, default=None, metavar="DIR")
+    gen.add_argument("--check", action="store_true", help="fail if the committed generated files are out of date")
+    gen.set_defaults(func=_codegen)
+
+    dec = sub.add_parser("decode", help="decode a captured frame given in hex")
+    dec.add_argument("hex", nargs="+", help="frame bytes in hex; spaces and colons are ignored")
+    dec.add_argument("--own", type=lambda v: int(v, 0), default=None, metavar="ADDR",
+                     help="check the destination against this node address")
+    dec.set_defaults(func=_decode)
+
+
+def _spec_check(args: argparse.Namespace) -> int:
+    from codegen.model import load_spec
+
+    spec = load_spec(args.spec)
+    print(f"spec ok: {len(spec.nodes)} nodes on {len(spec.buses)} buses, {len(spec.messages)} messages, "
+          f"largest frame {spec.max_frame} bytes, sha256 {spec.hash[:12]}")
+    return 0
+
+
+def _spec_nodes(args: argparse.Namespace) -> int:
+    from codegen.model import load_spec
+
+    spec = load_spec(args.spec)
+    print(f"{'node':9} {'addr':5} {'lvl':3} {'bus':8} {'bus master':10} {'masters':8} {'status':9} seed")
+    for n in spec.nodes:
+        master = spec.buses[n.bus].master if n.bus else "-"
+        print(f"{n.short:9} 0x{n.address:02X}  {n.level:<3} {n.bus or '-':8} {master:10} {n.masters or '-':8} {n.status:9} {n.section}")
+    print(f"{'(all)':9} 0x{spec.broadcast:02X}  broadcast, never a node address (seed 3.2.1)")
+    return 0
+
+
+def _codegen(args: argparse.Namespace) -> int:
+    from codegen.generate import render, stale, write
+    from codegen.model import load_spec
+
+    start = time.perf_counter()
+    spec = load_spec(args.spec)
+    files = render(spec)
+    if args.check:
+        out_of_date = stale(files)
+        if out_of_date:
+            listed = ", ".join(str(p) for p in out_of_date[:5]) + (" ..." if len(out_of_date) > 5 else "")
+            raise UserError(f"generated files are out of date with the spec: {listed} (run `make codegen`)")
+        print(f"generated files up to date ({len(files)} files)")
+        return 0
+    changed = write(files)
+    print(f"codegen: {len(files)} files, {len(changed)} changed, {time.perf_counter() - start:.2f} s")
+    return 0
+
+
+def _decode(args: argparse.Namespace) -> int:
+    text = "".join(args.hex).replace(":", "").replace(" ", "")
+    if text.lower().startswith("0x"):
+        text = text[2:]
+    try:
+        data = bytes.fromhex(text)
+    except ValueError:
+        raise UserError(f"decode: '{' '.join(args.hex)}' is not a hex string") from None
+    from arachnae_proto import CodecError, frame
+    from arachnae_proto.network import name_of
+
+    try:
+        f = frame.parse(data, args.own)
+    except CodecError as err:
+        raise UserError(f"decode: {err.kind.name}: {err}") from None
+    m = f.message
+    print(f"{name_of(f.src)} -> {name_of(f.dst)}  {m.NAME} (opcode 0x{m.OPCODE:02X}, seed {m.SECTION})")
+    for info in m.FIELDS:
+        print(f"  {info.name:14} {info.describe(getattr(m, info.name))}")
+    sys.stdout.flush()
+    return 0

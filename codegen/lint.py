@@ -1,0 +1,282 @@
+"""Checks that the spec is well-formed and means something consistent.
+
+Structure is checked with JSON Schema (codegen/schema/); meaning here: unique
+addresses and opcodes, widths that hold their ranges, references that resolve,
+and routes that stay on one bus. All problems are collected and reported
+together as `file:line: message`, one per line.
+"""
+from __future__ import annotations
+
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+import jsonschema
+import yaml
+
+from arachnae.errors import UserError, located
+from codegen.encoding import Linear, Log10, to_fraction
+from codegen.yaml_lines import line_of, load_yaml
+
+SCHEMA_DIR = Path(__file__).resolve().parent / "schema"
+
+
+class Report:
+    """Collects diagnostics for several files."""
+
+    def __init__(self) -> None:
+        self.problems: list[str] = []
+
+    def add(self, path: Path, doc: Any, where: list[Any], message: str) -> None:
+        self.problems.append(located(str(path), line_of(doc, where), message))
+
+    def raise_if_any(self) -> None:
+        if self.problems:
+            raise UserError("\n".join(self.problems))
+
+
+def _schema_check(path: Path, doc: Any, schema_name: str, report: Report) -> None:
+    schema = yaml.safe_load((SCHEMA_DIR / schema_name).read_text())
+    validator = jsonschema.Draft202012Validator(schema)
+    for err in sorted(validator.iter_errors(doc), key=lambda e: list(map(str, e.absolute_path))):
+        where = list(err.absolute_path)
+        field = ".".join(str(p) for p in where) or "(top level)"
+        report.add(path, doc, where, f"{field}: {_schema_message(err)}")
+
+
+def _schema_message(err: jsonschema.ValidationError) -> str:
+    if err.validator == "additionalProperties":
+        return err.message.replace("Additional properties are not allowed", "unknown key(s)")
+    if err.validator == "required":
+        return err.message.replace("is a required property", "is missing")
+    return err.message
+
+
+def check_documents(nodes_path: Path, messages_path: Path) -> tuple[dict, dict]:
+    """Load both spec files and return them if they are valid; else raise UserError with every problem."""
+    report = Report()
+    nodes_doc = load_yaml(nodes_path)
+    messages_doc = load_yaml(messages_path)
+    _schema_check(nodes_path, nodes_doc, "nodes.schema.yaml", report)
+    _schema_check(messages_path, messages_doc, "messages.schema.yaml", report)
+    report.raise_if_any()
+    roles = _lint_nodes(nodes_path, nodes_doc, report)
+    _lint_messages(messages_path, messages_doc, nodes_doc, roles, report)
+    report.raise_if_any()
+    return nodes_doc, messages_doc
+
+
+# -- nodes ----------------------------------------------------------------------
+def _lint_nodes(path: Path, doc: dict, report: Report) -> set[str]:
+    broadcast = doc["address"]["broadcast"]
+    level_shift = doc["address"]["width_bits"] - doc["address"]["level_bits"]
+    buses = doc["buses"]
+    seen_addr: dict[int, str] = {}
+    seen_short: set[str] = set()
+    shorts = {n["short"] for n in doc["nodes"]}
+    mastered: dict[str, str] = {}
+    for i, n in enumerate(doc["nodes"]):
+        at = ["nodes", i]
+        addr, short = n["address"], n["short"]
+        if addr == broadcast:
+            report.add(path, doc, at, f"{short}: address 0x{addr:02X} is the broadcast address (seed 3.2.1)")
+        elif addr in seen_addr:
+            report.add(path, doc, at, f"{short}: duplicate address 0x{addr:02X}, already used by {seen_addr[addr]}")
+        seen_addr.setdefault(addr, short)
+        if short in seen_short:
+            report.add(path, doc, at, f"duplicate node name {short}")
+        seen_short.add(short)
+        if addr >> level_shift != n["level"]:
+            report.add(path, doc, at, f"{short}: level {n['level']} does not match address 0x{addr:02X} (top bits say {addr >> level_shift})")
+        if n["bus"] is not None and n["bus"] not in buses:
+            report.add(path, doc, at, f"{short}: unknown bus '{n['bus']}'")
+        if "masters" in n:
+            if n["masters"] not in buses:
+                report.add(path, doc, at, f"{short}: masters unknown bus '{n['masters']}'")
+            elif buses[n["masters"]]["master"] != short:
+                report.add(path, doc, at, f"{short}: masters '{n['masters']}' but that bus names {buses[n['masters']]['master']} as master")
+            mastered[n["masters"]] = short
+    for name, b in buses.items():
+        at = ["buses", name]
+        if b["master"] not in shorts:
+            report.add(path, doc, at, f"bus {name}: unknown master node '{b['master']}'")
+        elif name not in mastered:
+            report.add(path, doc, at, f"bus {name}: its master {b['master']} does not declare `masters: {name}`")
+        if b["arbitration"] not in doc["arbitration"]:
+            report.add(path, doc, at, f"bus {name}: unknown arbitration rule '{b['arbitration']}'")
+    roles = {n["role"] for n in doc["nodes"]}
+    for i, q in enumerate(doc["post"]["quorums"]):
+        for role in q["unit_roles"]:
+            if role not in roles:
+                report.add(path, doc, ["post", "quorums", i], f"quorum {q['name']}: unknown role '{role}'")
+        units = {n.get(q["unit_key"]) for n in doc["nodes"] if n["role"] in q["unit_roles"]} - {None}
+        if q["min_complete"] > len(units):
+            report.add(path, doc, ["post", "quorums", i], f"quorum {q['name']}: needs {q['min_complete']} units but only {len(units)} exist")
+    return roles
+
+
+# -- messages -------------------------------------------------------------------
+def _lint_messages(path: Path, doc: dict, nodes_doc: dict, roles: set[str], report: Report) -> None:
+    _lint_checksum(path, doc, report)
+    for kind, key in (("enums", "values"), ("flags", "bits")):
+        for name, e in doc[kind].items():
+            values = list(e[key].values())
+            if len(set(values)) != len(values):
+                report.add(path, doc, [kind, name], f"{name}: two names share one value")
+            for text_key in e.get("texts", {}):
+                if text_key not in e[key]:
+                    report.add(path, doc, [kind, name, "texts", text_key], f"{name}: text for unknown value {text_key}")
+    seen_op: dict[int, str] = {}
+    seen_name: set[str] = set()
+    max_payload = doc["frame"]["max_payload"]
+    for i, m in enumerate(doc["messages"]):
+        at = ["messages", i]
+        name = m["name"]
+        if name in seen_name:
+            report.add(path, doc, at, f"duplicate message name {name}")
+        seen_name.add(name)
+        if m["opcode"] in seen_op:
+            report.add(path, doc, at + ["opcode"], f"{name}: duplicate opcode 0x{m['opcode']:02X}, already used by {seen_op[m['opcode']]}")
+        seen_op.setdefault(m["opcode"], name)
+        for side in ("from", "to"):
+            for j, role in enumerate(m[side]):
+                if role not in roles:
+                    report.add(path, doc, at + [side, j], f"{name}: unknown node role '{role}' in `{side}`")
+        _lint_fields(path, doc, at, m, max_payload, report)
+        if all(r in roles for r in m["from"] + m["to"]):
+            _lint_routes(path, doc, at, m, nodes_doc, report)
+
+
+def _lint_checksum(path: Path, doc: dict, report: Report) -> None:
+    from codegen.model import Checksum
+
+    c = doc["frame"]["checksum"]
+    crc = Checksum(c["name"], c["width"], c["poly"], c["init"], c["refin"], c["refout"], c["xorout"], c["check"])
+    got = crc.compute(b"123456789")
+    if got != c["check"]:
+        report.add(path, doc, ["frame", "checksum", "check"],
+                   f"checksum {c['name']}: check value 0x{c['check']:X} does not match the parameters (they give 0x{got:X})")
+
+
+def _lint_fields(path: Path, doc: dict, at: list, m: dict, max_payload: int, report: Report) -> None:
+    name = m["name"]
+    fields = m.get("fields", [])
+    names: list[str] = []
+    bit_pos = 0
+    for k, f in enumerate(fields):
+        fat = at + ["fields", k]
+        fname = f"{name}.{f['name']}"
+        if f["name"] in names:
+            report.add(path, doc, fat, f"{fname}: duplicate field name")
+        bits = 8 if f["type"] in ("node", "char") else f.get("bits")
+        if bits is None:
+            report.add(path, doc, fat, f"{fname}: `bits` is required for type {f['type']}")
+            continue
+        if f["type"] in ("node", "char") and f.get("bits", 8) != 8:
+            report.add(path, doc, fat, f"{fname}: a {f['type']} is 8 bits wide")
+        if bits > 16 or bits not in (8, 16) and bits > 8:
+            report.add(path, doc, fat, f"{fname}: {bits}-bit fields are not supported (use up to 8, or 16)")
+        if bits == 16 and bit_pos % 8:
+            report.add(path, doc, fat, f"{fname}: a 16-bit field must start on a byte boundary")
+        if bits < 8 and bit_pos // 8 != (bit_pos + bits - 1) // 8:
+            report.add(path, doc, fat, f"{fname}: a {bits}-bit field must not straddle a byte boundary")
+        if f["type"] == "enum":
+            _lint_enum_ref(path, doc, fat, fname, f, "enum", "enums", "values", bits, report)
+        elif f["type"] == "flags":
+            _lint_enum_ref(path, doc, fat, fname, f, "flags", "flags", "bits", bits, report)
+        elif "enum" in f or "flags" in f:
+            report.add(path, doc, fat, f"{fname}: only enum and flags fields take `enum`/`flags`")
+        if f["type"] in ("uint", "int"):
+            _lint_range(path, doc, fat, fname, f, bits, report)
+        elif any(k in f for k in ("scale", "offset", "log10")):
+            report.add(path, doc, fat, f"{fname}: only uint and int fields take scale, offset or log10")
+        if "count" in f:
+            if f["count"] not in names:
+                report.add(path, doc, fat + ["count"], f"{fname}: count refers to '{f['count']}', which is not an earlier field")
+            if k != len(fields) - 1:
+                report.add(path, doc, fat, f"{fname}: an array must be the last field")
+            if bits != 8:
+                report.add(path, doc, fat, f"{fname}: array elements must be 8 bits wide")
+        else:
+            bit_pos += bits
+        names.append(f["name"])
+    if bit_pos % 8:
+        report.add(path, doc, at, f"{name}: fields add up to {bit_pos} bits, not whole bytes")
+    size = bit_pos // 8
+    array = next((f for f in fields if "count" in f), None)
+    if array is not None:
+        count_field = next((f for f in fields if f["name"] == array["count"]), None)
+        if count_field is not None:
+            size += int(count_field.get("range", [0, 255])[1])
+    if size > max_payload:
+        report.add(path, doc, at, f"{name}: payload of up to {size} bytes exceeds the frame's max_payload {max_payload}")
+
+
+def _lint_enum_ref(path: Path, doc: dict, fat: list, fname: str, f: dict, key: str, table: str, values_key: str,
+                   bits: int, report: Report) -> None:
+    ref = f.get(key)
+    if ref is None:
+        report.add(path, doc, fat, f"{fname}: type {key} needs `{key}:`")
+    elif ref not in doc[table]:
+        report.add(path, doc, fat + [key], f"{fname}: unknown {key} '{ref}'")
+    else:
+        biggest = max(doc[table][ref][values_key].values())
+        if biggest >= 1 << bits:
+            report.add(path, doc, fat, f"{fname}: {key} {ref} has value {biggest}, wider than {bits} bits")
+
+
+def _lint_range(path: Path, doc: dict, fat: list, fname: str, f: dict, bits: int, report: Report) -> None:
+    lo_lim, hi_lim = (-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if f["type"] == "int" else (0, (1 << bits) - 1)
+    if "log10" in f and ("scale" in f or "offset" in f):
+        report.add(path, doc, fat, f"{fname}: log10 and scale/offset exclude each other")
+        return
+    if "log10" in f:
+        lg = f["log10"]
+        enc: Linear | Log10 = Log10(to_fraction(lg["ref"]), lg["per_decade"], bool(lg.get("saturate")), hi_lim)
+    else:
+        scale = to_fraction(f.get("scale", 1))
+        if scale == 0:
+            report.add(path, doc, fat + ["scale"], f"{fname}: scale must not be 0")
+            return
+        enc = Linear(scale, to_fraction(f.get("offset", 0)))
+    if "range" not in f:
+        if "log10" in f or not enc.identity:  # type: ignore[union-attr]
+            report.add(path, doc, fat, f"{fname}: a scaled field needs a physical `range`")
+        return
+    lo, hi = (to_fraction(v) for v in f["range"])
+    if lo > hi:
+        report.add(path, doc, fat + ["range"], f"{fname}: range [{f['range'][0]}, {f['range'][1]}] is empty")
+        return
+    raw_lo, raw_hi = enc.to_raw(lo), enc.to_raw(hi)
+    if isinstance(enc, Log10) and enc.saturate:
+        raw_lo, raw_hi = max(raw_lo, lo_lim), min(raw_hi, hi_lim)
+    if raw_lo < lo_lim or raw_hi > hi_lim:
+        unit = f" {f['unit']}" if "unit" in f else ""
+        report.add(path, doc, fat + ["range"],
+                   f"{fname}: range [{_num(lo)}, {_num(hi)}]{unit} needs raw {raw_lo}..{raw_hi}, "
+                   f"but {bits} {'signed ' if f['type'] == 'int' else ''}bits hold {lo_lim}..{hi_lim}")
+
+
+def _num(v: Fraction) -> str:
+    return str(int(v)) if v.denominator == 1 else f"{float(v):g}"
+
+
+def _lint_routes(path: Path, doc: dict, at: list, m: dict, nodes_doc: dict, report: Report) -> None:
+    """Every sender must reach some receiver over one bus, and every receiver some sender (decision 2)."""
+    nodes = nodes_doc["nodes"]
+
+    def share(a: dict, b: dict) -> bool:
+        return any(x.get("masters") is not None and y["bus"] == x["masters"] for x, y in ((a, b), (b, a)))
+
+    senders = [n for n in nodes if n["role"] in m["from"]]
+    receivers = [n for n in nodes if n["role"] in m["to"]]
+    for side, group, other in (("from", senders, receivers), ("to", receivers, senders)):
+        for role in dict.fromkeys(n["role"] for n in group):
+            members = [n for n in group if n["role"] == role]
+            if not any(share(n, o) for n in members for o in other if o is not n):
+                peers = "/".join(m["to"] if side == "from" else m["from"])
+                report.add(path, doc, at + [side], f"{m['name']}: {role} and {peers} are not on one bus (decision 2: masters relay between layers)")
+    if m.get("broadcast"):
+        for role in m["from"]:
+            if not any(n.get("masters") for n in nodes if n["role"] == role):
+                report.add(path, doc, at + ["from"], f"{m['name']}: only bus masters may broadcast, {role} masters no bus")

@@ -1,0 +1,445 @@
+"""The spec as objects: the one model that codegen, model_check and sim2d read.
+
+`load_spec()` parses spec/nodes.yaml and spec/messages.yaml, checks structure and
+meaning (codegen.lint) and only then builds this model, so everything downstream
+may assume a consistent network.
+"""
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass, field
+from fractions import Fraction
+from functools import cached_property
+from pathlib import Path
+from typing import Iterator
+
+from codegen.encoding import MILLI, Encoding, Linear, Log10, to_fraction
+
+SPEC_DIR = Path(__file__).resolve().parent.parent / "spec"
+SPEC_FILES = ("nodes.yaml", "messages.yaml")
+
+
+@dataclass(frozen=True)
+class Node:
+    short: str
+    long: str
+    address: int
+    level: int
+    role: str
+    bus: str | None          # the bus it is a slave on (None for the MCP)
+    masters: str | None      # the bus it is master of
+    status: str              # 'required' | 'optional'
+    section: str
+    leg: int | None = None
+    joint: int | None = None
+
+    @property
+    def ident(self) -> str:
+        """A C/Python identifier: LCP(2) -> LCP_2, JAC(1,3) -> JAC_1_3, APU/SDF -> APU_SDF."""
+        return self.short.replace("/", "_").replace("(", "_").replace(",", "_").rstrip(")")
+
+    @property
+    def required(self) -> bool:
+        return self.status == "required"
+
+
+@dataclass(frozen=True)
+class Bus:
+    name: str
+    long: str
+    level: int
+    master: str
+    baud: int
+    bits_per_char: int
+    turnaround_us: float
+    idle_gap_chars: float
+    response_timeout_ms: float
+    id_retries: int
+    arbitration: str
+    section: str
+    slaves: tuple[str, ...] = ()
+
+    @property
+    def char_time_us(self) -> float:
+        return self.bits_per_char * 1e6 / self.baud
+
+    def frame_time_us(self, frame_bytes: int) -> float:
+        """Time on the wire of a frame of `frame_bytes` bytes, without gap or turnaround."""
+        return frame_bytes * self.char_time_us
+
+    @property
+    def idle_gap_us(self) -> float:
+        return self.idle_gap_chars * self.char_time_us
+
+
+@dataclass(frozen=True)
+class Checksum:
+    name: str
+    width: int
+    poly: int
+    init: int
+    refin: bool
+    refout: bool
+    xorout: int
+    check: int
+
+    def compute(self, data: bytes) -> int:
+        """Bitwise reference implementation (the catalogue definition, for lint and vectors)."""
+        top, mask = 1 << (self.width - 1), (1 << self.width) - 1
+        crc = self.init
+        for byte in data:
+            if self.refin:
+                byte = int(f"{byte:08b}"[::-1], 2)
+            crc ^= byte << (self.width - 8)
+            for _ in range(8):
+                crc = ((crc << 1) ^ self.poly) & mask if crc & top else (crc << 1) & mask
+        if self.refout:
+            crc = int(f"{crc:0{self.width}b}"[::-1], 2)
+        return crc ^ self.xorout
+
+
+@dataclass(frozen=True)
+class Frame:
+    header: tuple[str, ...]
+    max_payload: int
+    checksum: Checksum
+    section: str
+
+    @property
+    def header_size(self) -> int:
+        return len(self.header)
+
+    @property
+    def crc_size(self) -> int:
+        return self.checksum.width // 8
+
+    @property
+    def overhead(self) -> int:
+        return self.header_size + self.crc_size
+
+    @property
+    def max_size(self) -> int:
+        return self.overhead + self.max_payload
+
+
+@dataclass(frozen=True)
+class Enum:
+    name: str
+    values: dict[str, int]
+    section: str
+    texts: dict[str, str] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Flags:
+    name: str
+    bits: dict[str, int]
+    section: str
+
+    @property
+    def mask(self) -> int:
+        mask = 0
+        for bit in self.bits.values():
+            mask |= bit
+        return mask
+
+
+@dataclass(frozen=True)
+class Field:
+    name: str
+    type: str                 # uint | int | enum | flags | node | char
+    bits: int
+    offset_bits: int          # from the start of the payload (fixed part)
+    enum: Enum | None = None
+    flags: Flags | None = None
+    unit: str = ""
+    encoding: Encoding = Linear()
+    range: tuple[Fraction, Fraction] | None = None   # physical, inclusive
+    count: str | None = None  # name of the field holding this array's length
+    count_max: int = 0
+    origin: str = "seed"
+    doc: str = ""
+
+    @property
+    def signed(self) -> bool:
+        return self.type == "int"
+
+    @property
+    def is_array(self) -> bool:
+        return self.count is not None
+
+    @property
+    def scaled(self) -> bool:
+        return not (isinstance(self.encoding, Linear) and self.encoding.identity)
+
+    @property
+    def raw_limits(self) -> tuple[int, int]:
+        """What the bits can hold."""
+        if self.signed:
+            return -(1 << (self.bits - 1)), (1 << (self.bits - 1)) - 1
+        return 0, (1 << self.bits) - 1
+
+    @property
+    def raw_range(self) -> tuple[int, int]:
+        """Valid raw values: the declared range encoded, or the type's own domain."""
+        if self.enum is not None:
+            return min(self.enum.values.values()), max(self.enum.values.values())
+        if self.range is None:
+            return self.raw_limits
+        lo, hi = (self.encoding.to_raw(v) for v in self.range)
+        limit_lo, limit_hi = self.raw_limits
+        if isinstance(self.encoding, Log10) and self.encoding.saturate:
+            lo, hi = max(lo, limit_lo), min(hi, limit_hi)
+        return lo, hi
+
+    @property
+    def byte_aligned(self) -> bool:
+        return self.offset_bits % 8 == 0 and self.bits % 8 == 0
+
+
+@dataclass(frozen=True)
+class Message:
+    name: str
+    seed_name: str
+    opcode: int
+    section: str
+    origin: str
+    broadcast: bool
+    senders: tuple[str, ...]
+    receivers: tuple[str, ...]
+    doc: str
+    fields: tuple[Field, ...]
+
+    @property
+    def fixed_size(self) -> int:
+        """Bytes before any array (all of the payload when there is none)."""
+        return sum(f.bits for f in self.fields if not f.is_array) // 8
+
+    @property
+    def array(self) -> Field | None:
+        return next((f for f in self.fields if f.is_array), None)
+
+    @property
+    def min_size(self) -> int:
+        arr = self.array
+        if arr is None:
+            return self.fixed_size
+        count_field = self.field(arr.count)
+        return self.fixed_size + max(0, count_field.raw_range[0])
+
+    @property
+    def max_size(self) -> int:
+        arr = self.array
+        return self.fixed_size + (arr.count_max if arr else 0)
+
+    def field(self, name: str) -> Field:
+        return next(f for f in self.fields if f.name == name)
+
+
+@dataclass(frozen=True)
+class Quorum:
+    name: str
+    unit_key: str
+    unit_roles: tuple[str, ...]
+    min_complete: int
+    section: str
+
+
+@dataclass(frozen=True)
+class PostRules:
+    verdicts: tuple[str, ...]
+    inactive_statuses: tuple[str, ...]
+    quorums: tuple[Quorum, ...]
+    section: str
+
+
+@dataclass
+class Spec:
+    nodes: tuple[Node, ...]
+    buses: dict[str, Bus]
+    arbitration: dict[str, dict]
+    post: PostRules
+    frame: Frame
+    enums: dict[str, Enum]
+    flags: dict[str, Flags]
+    messages: tuple[Message, ...]
+    broadcast: int
+    level_bits: int
+    sources: tuple[Path, ...]
+    hash: str                 # sha256 of the spec files, hex
+
+    # -- lookups -------------------------------------------------------------
+    @cached_property
+    def _by_short(self) -> dict[str, Node]:
+        return {n.short: n for n in self.nodes}
+
+    @cached_property
+    def _by_address(self) -> dict[int, Node]:
+        return {n.address: n for n in self.nodes}
+
+    @cached_property
+    def _by_name(self) -> dict[str, Message]:
+        return {m.name: m for m in self.messages}
+
+    @cached_property
+    def _by_opcode(self) -> dict[int, Message]:
+        return {m.opcode: m for m in self.messages}
+
+    def node(self, short: str) -> Node:
+        return self._by_short[short]
+
+    def node_at(self, address: int) -> Node | None:
+        return self._by_address.get(address)
+
+    def message(self, name: str) -> Message:
+        return self._by_name[name]
+
+    def message_for(self, opcode: int) -> Message | None:
+        return self._by_opcode.get(opcode)
+
+    @property
+    def hash32(self) -> int:
+        """The first 32 bits of the spec hash: what generated files embed and assert."""
+        return int(self.hash[:8], 16)
+
+    @cached_property
+    def roles(self) -> tuple[str, ...]:
+        seen: dict[str, None] = {}
+        for n in self.nodes:
+            seen.setdefault(n.role, None)
+        return tuple(seen)
+
+    def role_nodes(self, role: str) -> list[Node]:
+        return [n for n in self.nodes if n.role == role]
+
+    def receives(self, role: str) -> list[Message]:
+        return [m for m in self.messages if role in m.receivers]
+
+    def sends(self, role: str) -> list[Message]:
+        return [m for m in self.messages if role in m.senders]
+
+    def slaves(self, bus: str) -> list[Node]:
+        return [n for n in self.nodes if n.bus == bus]
+
+    def shared_bus(self, a: Node, b: Node) -> Bus | None:
+        """The bus on which a and b can exchange frames: one of them masters it, the other sits on it."""
+        for x, y in ((a, b), (b, a)):
+            if x.masters is not None and y.bus == x.masters:
+                return self.buses[x.masters]
+        return None
+
+    def routes(self, message: Message) -> Iterator[tuple[Node, Node, Bus]]:
+        """Every (sender, receiver, bus) the message may travel between (decision 2)."""
+        for s in self.nodes:
+            if s.role not in message.senders:
+                continue
+            for r in self.nodes:
+                if r.role in message.receivers and r is not s:
+                    bus = self.shared_bus(s, r)
+                    if bus is not None:
+                        yield s, r, bus
+
+    @property
+    def max_frame(self) -> int:
+        return self.frame.overhead + max(m.max_size for m in self.messages)
+
+    def frame_time_us(self, bus: str, payload_len: int) -> float:
+        """Time on the wire for a frame with `payload_len` payload bytes on `bus`."""
+        return self.buses[bus].frame_time_us(self.frame.overhead + payload_len)
+
+
+# -- building -------------------------------------------------------------------
+def _fields(raw_fields: list[dict], enums: dict[str, Enum], flags: dict[str, Flags], max_payload: int) -> tuple[Field, ...]:
+    out: list[Field] = []
+    offset = 0
+    fixed_bytes = sum(_bits_of(f) for f in raw_fields if "count" not in f) // 8
+    for f in raw_fields:
+        bits = _bits_of(f)
+        if "log10" in f:
+            lg = f["log10"]
+            encoding: Encoding = Log10(to_fraction(lg["ref"]), lg["per_decade"], bool(lg.get("saturate", False)), (1 << bits) - 1)
+        else:
+            encoding = Linear(to_fraction(f.get("scale", 1)), to_fraction(f.get("offset", 0)))
+        rng = tuple(to_fraction(v) for v in f["range"]) if "range" in f else None
+        count_max = 0
+        if "count" in f:
+            count_field = next(c for c in raw_fields if c["name"] == f["count"])
+            declared = count_field.get("range", [0, 255])[1]
+            count_max = min(int(declared), max_payload - fixed_bytes)
+        out.append(Field(
+            name=f["name"], type=f["type"], bits=bits, offset_bits=offset,
+            enum=enums.get(f.get("enum", "")), flags=flags.get(f.get("flags", "")),
+            unit=f.get("unit", ""), encoding=encoding, range=rng,  # type: ignore[arg-type]
+            count=f.get("count"), count_max=count_max,
+            origin=f.get("origin", "seed"), doc=f.get("doc", ""),
+        ))
+        if "count" not in f:
+            offset += bits
+    return tuple(out)
+
+
+def _bits_of(f: dict) -> int:
+    return 8 if f["type"] in ("node", "char") else int(f.get("bits", 8))
+
+
+def build(nodes_doc: dict, messages_doc: dict, sources: tuple[Path, ...], digest: str) -> Spec:
+    """Build the model from documents that already passed schema and lint."""
+    nodes = tuple(
+        Node(short=n["short"], long=n["long"], address=n["address"], level=n["level"], role=n["role"],
+             bus=n["bus"], masters=n.get("masters"), status=n["status"], section=n["section"],
+             leg=n.get("leg"), joint=n.get("joint"))
+        for n in nodes_doc["nodes"]
+    )
+    buses = {
+        name: Bus(name=name, long=b["long"], level=b["level"], master=b["master"], baud=b["baud"],
+                  bits_per_char=b["bits_per_char"], turnaround_us=b["turnaround_us"],
+                  idle_gap_chars=b["idle_gap_chars"], response_timeout_ms=b["response_timeout_ms"],
+                  id_retries=b["id_retries"], arbitration=b["arbitration"], section=b["section"],
+                  slaves=tuple(n.short for n in nodes if n.bus == name))
+        for name, b in nodes_doc["buses"].items()
+    }
+    post_doc = nodes_doc["post"]
+    post = PostRules(
+        verdicts=tuple(post_doc["verdicts"]), inactive_statuses=tuple(post_doc["inactive_statuses"]),
+        quorums=tuple(Quorum(q["name"], q["unit_key"], tuple(q["unit_roles"]), q["min_complete"], q["section"])
+                      for q in post_doc["quorums"]),
+        section=post_doc["section"],
+    )
+    fdoc = messages_doc["frame"]
+    c = fdoc["checksum"]
+    frame = Frame(tuple(fdoc["header"]), fdoc["max_payload"],
+                  Checksum(c["name"], c["width"], c["poly"], c["init"], c["refin"], c["refout"], c["xorout"], c["check"]),
+                  fdoc["section"])
+    enums = {k: Enum(k, dict(v["values"]), v["section"], dict(v.get("texts", {}))) for k, v in messages_doc["enums"].items()}
+    flags = {k: Flags(k, dict(v["bits"]), v["section"]) for k, v in messages_doc["flags"].items()}
+    messages = tuple(
+        Message(name=m["name"], seed_name=m.get("seed_name", m["name"]), opcode=m["opcode"], section=m["section"],
+                origin=m.get("origin", "seed"), broadcast=bool(m.get("broadcast", False)),
+                senders=tuple(m["from"]), receivers=tuple(m["to"]), doc=m["doc"],
+                fields=_fields(m.get("fields", []), enums, flags, fdoc["max_payload"]))
+        for m in messages_doc["messages"]
+    )
+    return Spec(nodes=nodes, buses=buses, arbitration=dict(nodes_doc["arbitration"]), post=post, frame=frame,
+                enums=enums, flags=flags, messages=messages, broadcast=nodes_doc["address"]["broadcast"],
+                level_bits=nodes_doc["address"]["level_bits"], sources=sources, hash=digest)
+
+
+def spec_digest(paths: tuple[Path, ...]) -> str:
+    h = hashlib.sha256()
+    for p in paths:
+        h.update(p.name.encode() + b"\0" + p.read_bytes() + b"\0")
+    return h.hexdigest()
+
+
+def load_spec(spec_dir: Path | str | None = None) -> Spec:
+    """Load, check and model the spec; raises arachnae.errors.UserError listing every problem."""
+    from codegen.lint import check_documents  # late import: lint needs this module's types
+
+    directory = Path(spec_dir) if spec_dir is not None else SPEC_DIR
+    paths = tuple(directory / name for name in SPEC_FILES)
+    nodes_doc, messages_doc = check_documents(paths[0], paths[1])
+    return build(nodes_doc, messages_doc, paths, spec_digest(paths))
+
+
+__all__ = ["Spec", "Node", "Bus", "Message", "Field", "Enum", "Flags", "Frame", "Checksum", "PostRules",
+           "Quorum", "load_spec", "SPEC_DIR", "MILLI"]
