@@ -30,8 +30,10 @@ codegen: setup
 spec-check: setup
 	$(ARACHNAE) spec check
 
+## Benchmarks print figures next to references measured in the same run.
 bench: setup
-	$(PY) bench/codec_bench.py
+	-$(PY) -m pip install -q pymavlink  # reference for the codec figures; optional
+	@for b in bench/*_bench.py; do echo "== $$b"; $(PY) $$b || exit 1; done
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache

@@ -1,0 +1,118 @@
+"""`arachnae spec check` names the file and line of every deliberately broken spec.
+
+Each case copies the real spec, breaks it in one place, and expects one exact
+diagnostic at the line where the problem is.
+"""
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from arachnae.errors import UserError
+from codegen.model import SPEC_DIR, load_spec
+
+N, M = "nodes.yaml", "messages.yaml"
+
+# (id, file, text to replace, replacement, text on the line the diagnostic names (None: the replacement), message)
+CASES = [
+    ("duplicate_address", N, "address: 0x02, level: 0, role: NP3", "address: 0x01, level: 0, role: NP3", None,
+     "NP3: duplicate address 0x01, already used by MCP"),
+    ("broadcast_as_node", N, "address: 0x08, level: 0, role: RLC", "address: 0xFF, level: 7, role: RLC", None,
+     "RLC: address 0xFF is the broadcast address (seed 3.2.1)"),
+    ("level_mismatch", N, "address: 0x27, level: 1, role: USRC", "address: 0x27, level: 2, role: USRC", None,
+     "USRC: level 2 does not match address 0x27 (top bits say 1)"),
+    ("unknown_bus", N, "role: USRC, bus: sensor,", "role: USRC, bus: sensr,", None, "USRC: unknown bus 'sensr'"),
+    ("unknown_master", N, "master: MMC, baud: 19200", "master: MMX, baud: 19200", None, "bus leg: unknown master node 'MMX'"),
+    ("duplicate_yaml_key", N, "  leg:     {long:", "  first:   {long:", '  first:   {long: "MMC', "duplicate key 'first'"),
+    ("missing_key", N, 'role: NP3, bus: first, status: required, section: "3.2.3"', 'role: NP3, bus: first, section: "3.2.3"', None,
+     "nodes.1: 'status' is missing"),
+    ("bad_status", N, "role: SSC, bus: first, status: optional", "role: SSC, bus: first, status: maybe", None,
+     "nodes.4.status: 'maybe' is not one of ['required', 'optional']"),
+    ("yaml_syntax", N, '{short: SPU, long: "Sensor Processing Unit",', '{short: SPU, long: "Sensor Processing Unit",,', None,
+     "expected"),
+    ("quorum_too_big", N, "min_complete: 5", "min_complete: 7", None, "quorum legs: needs 7 units but only 6 exist"),
+    ("duplicate_opcode", M, "name: MOVE\n    opcode: 0x21", "name: MOVE\n    opcode: 0x20", None,
+     "MOVE: duplicate opcode 0x20, already used by DATA"),
+    ("field_wider_than_bits", M, "{name: angle, type: uint, bits: 16, unit: deg, range: [0, 359]}",
+     "{name: angle, type: uint, bits: 8, unit: deg, range: [0, 359]}", None,
+     "HEAD_SET_ABS.angle: range [0, 359] deg needs raw 0..359, but 8 bits hold 0..255"),
+    ("range_encoding_cannot_hold", M, 'unit: m, scale: "10/255", range: [0, 10]}', 'unit: m, scale: "10/255", range: [0, 11]}', None,
+     "XMIT_DATA_USRC.distance: range [0, 11] m needs raw 0..281, but 8 bits hold 0..255"),
+    ("signed_range", M, "{name: longitudinal, type: int, bits: 8, unit: deg, range: [-60, 60]}",
+     "{name: longitudinal, type: int, bits: 8, unit: deg, range: [-200, 60]}", None,
+     "XMIT_DATA_ISC.longitudinal: range [-200, 60] deg needs raw -200..60, but 8 signed bits hold -128..127"),
+    ("unknown_enum", M, "{name: mov_cmd, type: enum, enum: MOV_CMD, bits: 4}\n      - {name: param, type: uint, bits: 4, range: [0, 0], doc",
+     "{name: mov_cmd, type: enum, enum: MOVE_CMD, bits: 4}\n      - {name: param, type: uint, bits: 4, range: [0, 0], doc",
+     "enum: MOVE_CMD", "MOVE.mov_cmd: unknown enum 'MOVE_CMD'"),
+    ("enum_wider_than_field", M, "JAC_OUT_OF_ORDER: 3, LCP_OUT_OF_ORDER: 4}", "JAC_OUT_OF_ORDER: 3, LCP_OUT_OF_ORDER: 4, OTHER: 16}",
+     "{name: error, type: enum, enum: MMC_ERROR, bits: 4}", "STATUS_ACK_MMC.error: enum MMC_ERROR has value 16, wider than 4 bits"),
+    ("unknown_role", M, "from: [NP3, UIC_RCP]", "from: [NP3, UIC_RPC]", None, "MOVE: unknown node role 'UIC_RPC' in `from`"),
+    ("not_on_one_bus", M, "    from: [USRC]\n    to: [SPU]", "    from: [USRC]\n    to: [MCP]", None,
+     "XMIT_DATA_USRC: MCP and USRC are not on one bus (decision 2: masters relay between layers)"),
+    ("unknown_count_field", M, "{name: missing, type: node, count: missing_count}", "{name: missing, type: node, count: missing_cnt}", None,
+     "POST_REPORT.missing: count refers to 'missing_cnt', which is not an earlier field"),
+    ("checksum_check_value", M, "check: 0x29B1", "check: 0x29B2", None,
+     "checksum CRC-16/IBM-3740: check value 0x29B2 does not match the parameters (they give 0x29B1)"),
+    ("payload_too_big", M, "range: [1, 253]}", "range: [1, 254]}", "  - name: SPEAK\n",
+     "SPEAK: payload of up to 256 bytes exceeds the frame's max_payload 255"),
+    ("array_not_last", M, "      - {name: text, type: char, count: length}\n  - name: SPEAK_RESIDENT",
+     "      - {name: text, type: char, count: length}\n      - {name: tail, type: uint, bits: 8}\n  - name: SPEAK_RESIDENT",
+     "range: [1, 253]}\n      - {name: text, type: char, count: length}", "SPEAK.text: an array must be the last field"),
+]
+
+
+def _broken(tmp_path: Path, file: str, old: str, new: str) -> Path:
+    for name in (N, M):
+        shutil.copy(SPEC_DIR / name, tmp_path / name)
+    target = tmp_path / file
+    text = target.read_text()
+    assert text.count(old) == 1, f"fixture text not unique in the spec: {old!r}"
+    target.write_text(text.replace(old, new))
+    return target
+
+
+def _line_of(path: Path, needle: str) -> int:
+    """Line of the last line of the first occurrence of `needle`."""
+    text = path.read_text()
+    assert needle in text, needle
+    return text[: text.index(needle)].count("\n") + 1 + needle.rstrip("\n").count("\n")
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
+def test_broken_spec_names_file_and_line(tmp_path: Path, case) -> None:
+    _id, file, old, new, locate, message = case
+    target = _broken(tmp_path, file, old, new)
+    line = _line_of(target, locate if locate is not None else new)
+    with pytest.raises(UserError) as err:
+        load_spec(tmp_path)
+    problems = str(err.value).splitlines()
+    expected = f"{target}:{line}: {message}"
+    assert any(p.startswith(expected) for p in problems), f"wanted {expected!r}, got {problems}"
+
+
+def test_real_spec_passes(spec) -> None:
+    assert len(spec.nodes) == 39
+    assert spec.broadcast == 0xFF
+
+
+def test_cli_reports_every_problem_without_traceback(tmp_path: Path) -> None:
+    target = _broken(tmp_path, N, "address: 0x02, level: 0, role: NP3", "address: 0x01, level: 0, role: NP3")
+    text = target.read_text().replace("role: USRC, bus: sensor,", "role: USRC, bus: sensr,")
+    target.write_text(text)
+    run = subprocess.run([sys.executable, "-m", "arachnae", "spec", "check", "--spec", str(tmp_path)],
+                         capture_output=True, text=True)
+    assert run.returncode == 1
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 2 and all(line.startswith(f"{target}:") for line in lines), run.stderr
+    assert "Traceback" not in run.stderr
+
+
+def test_missing_spec_file_is_one_line(tmp_path: Path) -> None:
+    run = subprocess.run([sys.executable, "-m", "arachnae", "spec", "check", "--spec", str(tmp_path)],
+                         capture_output=True, text=True)
+    assert run.returncode == 1
+    assert run.stderr.strip() == f"{tmp_path / N}: cannot read: No such file or directory"
