@@ -4,7 +4,7 @@ PY       := $(VENV)/bin/python
 ARACHNAE := $(VENV)/bin/arachnae
 STAMP    := $(VENV)/.setup-stamp
 
-.PHONY: setup run test codegen codegen-check spec-check check bench clean
+.PHONY: setup run test scenarios codegen spec-check check bench clean
 
 setup: $(STAMP)
 
@@ -12,17 +12,20 @@ $(STAMP): pyproject.toml scripts/setup.sh scripts/apt-packages.txt
 	./scripts/setup.sh
 	touch $@
 
-## The main job on the built-in default scenario.
+## The main job: the default scenario, outputs in runs/default/.
 run: setup
-	$(ARACHNAE) spec check
-	$(ARACHNAE) codegen --check
-	$(ARACHNAE) decode 030122020210aab4
+	$(ARACHNAE) sim run scenarios/default.yaml --out runs/default
 
 ## All tests, as CI runs them.
 test: setup
 	$(ARACHNAE) spec check
 	$(ARACHNAE) codegen --check
 	$(PY) -m pytest
+	$(MAKE) scenarios
+
+## The scenario library, two seeds each, every expectation must hold.
+scenarios: setup
+	$(ARACHNAE) sim batch $(filter-out scenarios/bench_60s.yaml,$(wildcard scenarios/*.yaml)) --seeds 1-2 -j 2 --out runs/batch
 
 codegen: setup
 	$(ARACHNAE) codegen

@@ -237,6 +237,18 @@ class Message:
 
 
 @dataclass(frozen=True)
+class Protocol:
+    """Timing rules the seed leaves open (nodes.yaml `protocol`)."""
+
+    response_timeout_to: str      # 'first_byte' | 'last_byte'
+    master_defer_slots: int
+    post_report_timeout_ms: float
+    move_retries: int
+    setpoint_refresh_ms: float
+    section: str
+
+
+@dataclass(frozen=True)
 class Quorum:
     name: str
     unit_key: str
@@ -258,6 +270,7 @@ class Spec:
     nodes: tuple[Node, ...]
     buses: dict[str, Bus]
     arbitration: dict[str, dict]
+    protocol: Protocol
     post: PostRules
     frame: Frame
     enums: dict[str, Enum]
@@ -419,7 +432,10 @@ def build(nodes_doc: dict, messages_doc: dict, sources: tuple[Path, ...], digest
                 fields=_fields(m.get("fields", []), enums, flags, fdoc["max_payload"]))
         for m in messages_doc["messages"]
     )
-    return Spec(nodes=nodes, buses=buses, arbitration=dict(nodes_doc["arbitration"]), post=post, frame=frame,
+    p = nodes_doc["protocol"]
+    protocol = Protocol(p["response_timeout_to"], p["master_defer_slots"], p["post_report_timeout_ms"],
+                        p["move_retries"], p["setpoint_refresh_ms"], p["section"])
+    return Spec(nodes=nodes, buses=buses, arbitration=dict(nodes_doc["arbitration"]), protocol=protocol, post=post, frame=frame,
                 enums=enums, flags=flags, messages=messages, broadcast=nodes_doc["address"]["broadcast"],
                 level_bits=nodes_doc["address"]["level_bits"], sources=sources, hash=digest)
 
@@ -441,5 +457,5 @@ def load_spec(spec_dir: Path | str | None = None) -> Spec:
     return build(nodes_doc, messages_doc, paths, spec_digest(paths))
 
 
-__all__ = ["Spec", "Node", "Bus", "Message", "Field", "Enum", "Flags", "Frame", "Checksum", "PostRules",
+__all__ = ["Spec", "Node", "Bus", "Message", "Field", "Enum", "Flags", "Frame", "Checksum", "PostRules", "Protocol",
            "Quorum", "load_spec", "SPEC_DIR", "MILLI"]

@@ -1,0 +1,115 @@
+"""`arachnae sim run` and `arachnae sim batch` (issue 4)."""
+from __future__ import annotations
+
+import argparse
+import sys
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+from typing import Any
+
+from arachnae.errors import UserError
+
+
+def register(sub: Any) -> None:
+    sim = sub.add_parser("sim", help="2-D simulation of the robot and its network")
+    ssub = sim.add_subparsers(dest="sim_command", metavar="SIMCOMMAND", parser_class=type(sim))
+    ssub.required = True
+
+    run = ssub.add_parser("run", help="run one scenario headless")
+    run.add_argument("scenario", help="scenario YAML file")
+    run.add_argument("--seed", type=int, help="override the scenario's seed")
+    run.add_argument("--out", help="output folder (default sim-out/NAME-seedN)")
+    run.add_argument("--gif", action="store_true", help="also write an animation run.gif")
+    run.set_defaults(func=cmd_run)
+
+    batch = ssub.add_parser("batch", help="run scenarios x seeds in parallel")
+    batch.add_argument("scenarios", nargs="+", help="scenario YAML files")
+    batch.add_argument("--seeds", default="1", help="seeds: '1,2,7' or '1-10' (default 1)")
+    batch.add_argument("-j", "--jobs", type=int, default=None, help="worker processes (default: CPU count)")
+    batch.add_argument("--out", default="sim-out", help="parent folder of the runs' output folders")
+    batch.set_defaults(func=cmd_batch)
+
+
+def parse_seeds(text: str) -> list[int]:
+    seeds: list[int] = []
+    try:
+        for part in text.split(","):
+            if "-" in part.strip()[1:]:
+                a, b = part.split("-", 1)
+                seeds.extend(range(int(a), int(b) + 1))
+            else:
+                seeds.append(int(part))
+    except ValueError:
+        raise UserError(f"--seeds: expected numbers like '1,2,7' or '1-10', got {text!r}") from None
+    if not seeds or any(s < 0 for s in seeds):
+        raise UserError(f"--seeds: expected non-negative seeds, got {text!r}")
+    return seeds
+
+
+def _check_file(path: str) -> None:
+    if not Path(path).is_file():
+        raise UserError(f"{path}: no such scenario file")
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from sim2d import runner
+
+    _check_file(args.scenario)
+    outcome = runner.run(args.scenario, args.seed, gif=args.gif)
+    out = runner.write_outputs(outcome, args.out or runner.default_out(outcome), gif=args.gif)
+    m = outcome.result.metrics
+    print(f"{outcome.scenario.name} seed {outcome.scenario.seed}: POST {m['post']['verdict']}, "
+          f"walked {m['distance_walked_m']:.2f} m, collisions {m['collisions']}, frames {m['frames']}")
+    print(f"trace hash {m['trace_hash']}")
+    print(f"output {out}")
+    for name, ok, detail in outcome.expectations:
+        print(f"  {'PASS' if ok else 'FAIL'} {name}: {detail}")
+    if outcome.failed:
+        sys.stderr.write(f"{outcome.scenario.path}: expectation failed: {', '.join(n for n, _, _ in outcome.failed)}\n")
+        return 1
+    return 0
+
+
+def _batch_one(job: tuple[str, int, str]) -> tuple[str, int, dict[str, Any] | None, list, str | None]:
+    from sim2d import runner
+
+    path, seed, out_root = job
+    try:
+        outcome = runner.run(path, seed)
+        runner.write_outputs(outcome, Path(out_root) / f"{outcome.scenario.name}-seed{seed}")
+        return path, seed, outcome.result.metrics, outcome.expectations, None
+    except UserError as exc:
+        return path, seed, None, [], str(exc)
+
+
+def cmd_batch(args: argparse.Namespace) -> int:
+    from tqdm import tqdm
+
+    seeds = parse_seeds(args.seeds)
+    for p in args.scenarios:
+        _check_file(p)
+    from sim2d.runner import load_spec_once
+    from sim2d.scenario import load_scenario
+    spec = load_spec_once()
+    for p in args.scenarios:
+        load_scenario(p, spec)          # report a bad file before starting any worker
+    jobs = [(p, s, args.out) for p in args.scenarios for s in seeds]
+    rows = []
+    with ProcessPoolExecutor(max_workers=args.jobs) as pool:
+        for row in tqdm(pool.map(_batch_one, jobs), total=len(jobs), desc="sim batch", unit="run", file=sys.stderr):
+            rows.append(row)
+    header = f"{'scenario':32} {'seed':>5} {'POST':12} {'walked_m':>8} {'coll':>4} {'lost':>5} {'result':6} hash"
+    print(header)
+    failures = 0
+    for path, seed, m, exps, err in rows:
+        if err is not None:
+            failures += 1
+            print(f"{Path(path).stem:32} {seed:>5} ERROR {err}")
+            continue
+        bad = [n for n, ok, _ in exps if not ok]
+        failures += bool(bad)
+        print(f"{m['scenario'][:32]:32} {seed:>5} {str(m['post']['verdict']):12} {m['distance_walked_m']:8.2f} "
+              f"{m['collisions']:>4} {m['frame_loss']:>5} {'FAIL' if bad else 'PASS':6} {m['trace_hash'][:12]}"
+              + (f"  failed: {', '.join(bad)}" if bad else ""))
+    print(f"{len(rows) - failures} passed, {failures} failed")
+    return 1 if failures else 0

@@ -1,0 +1,101 @@
+"""Metrics of a finished run and the scenario's expectations checked against them."""
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from sim2d.sim import Simulation
+
+
+def reaction_latencies(stimuli: list[tuple[float, str]], moves: list[tuple[float, int]],
+                       busy: list[tuple[float, float]] = ()) -> list[float]:
+    """For each new stimulus, the time until the MMC receives the next MOVE (seed 5.2).
+
+    A stimulus while the robot is already escaping (a `busy` window) needs no new reaction.
+    """
+    out: list[float] = []
+    answered_until = -1.0
+    for t, _ in sorted(stimuli):
+        if t <= answered_until or any(a <= t <= b for a, b in busy):
+            continue
+        nxt = next((m for m, _ in moves if m >= t), None)
+        if nxt is None:
+            continue
+        out.append(round(nxt - t, 6))
+        answered_until = nxt
+    return out
+
+
+def build_metrics(sim: "Simulation") -> dict[str, Any]:
+    from sim2d.sim import trace_hash
+    dur = sim.scenario.duration
+    buses = {}
+    for name, b in sim.buses.items():
+        st = b.stats
+        buses[name] = {"load": round(st.busy_s / dur, 4), "frames": st.frames, "bytes": st.bytes,
+                       "collisions": st.collisions, "lost": st.lost, "corrupted": st.corrupted, "delayed": st.delayed}
+    v = sim.verdict
+    lat = reaction_latencies(sim.stimuli, sim.moves, sim.escapes)
+    ev = sim.robot.events
+    x0, y0, _ = sim.scenario.start
+    x, y, th = sim.robot.pose
+    return {
+        "scenario": sim.scenario.name,
+        "seed": sim.scenario.seed,
+        "duration_s": dur,
+        "post": {"verdict": v.verdict if v else None, "missing": list(v.missing) if v else [],
+                 "reasons": list(v.reasons) if v else [], "time_s": sim.verdict_time},
+        "distance_walked_m": round(sim.distance, 4),
+        "displacement_m": round(math.hypot(x - x0, y - y0), 4),
+        "final_pose": [round(x, 4), round(y, 4), round(math.degrees(th), 2)],
+        "collisions": ev.collisions,
+        "min_clearance_m": None if math.isinf(sim.min_clearance) else round(sim.min_clearance, 4),
+        "blocked_leg_events": sum(1 for e in sim.events if e[1] == "blocked"),
+        "pit_events": sum(1 for e in sim.events if e[1] == "pit") + (1 if ev.fell else 0),
+        "fell": ev.fell,
+        "tilt_events": sim.tilt_events,
+        "max_tilt_deg": round(sim.max_tilt, 2),
+        "reach_time_s": sim.reach_time,
+        "entered_forbidden_s": sim.entered_time,
+        "moves": len(sim.moves),
+        "reaction_latencies_s": lat,
+        "max_reaction_s": max(lat) if lat else None,
+        "buses": buses,
+        "frames": len(sim.frames),
+        "frame_loss": sum(b["lost"] for b in buses.values()),
+        "battery_v": round(sim.robot.battery_voltage(), 3),
+        "trace_hash": trace_hash(sim.frames, sim.poses),
+    }
+
+
+def check_expectations(scenario: Any, m: dict[str, Any]) -> list[tuple[str, bool, str]]:
+    """(name, passed, detail) for each expectation the scenario declares."""
+    e = scenario.expect
+    out: list[tuple[str, bool, str]] = []
+    if e.post is not None:
+        got = m["post"]["verdict"]
+        out.append(("post", got == e.post, f"expected POST {e.post}, got {got} {m['post']['reasons']}"))
+    if e.no_collision:
+        out.append(("no_collision", m["collisions"] == 0, f"{m['collisions']} collision(s)"))
+    if e.reach is not None:
+        t = m["reach_time_s"]
+        ok = t is not None and t <= e.reach[1]
+        out.append(("reach", ok, f"region reached at {t} s, limit {e.reach[1]} s" if t is not None else
+                    f"region not reached within {e.reach[1]} s (final pose {m['final_pose']})"))
+    if e.min_clearance is not None:
+        c = m["min_clearance_m"]
+        out.append(("min_clearance", c is not None and c >= e.min_clearance, f"min clearance {c} m, needed {e.min_clearance} m"))
+    if e.never_moves:
+        out.append(("never_moves", m["distance_walked_m"] < 0.005, f"walked {m['distance_walked_m']} m"))
+    if e.min_distance is not None:
+        out.append(("min_distance", m["distance_walked_m"] >= e.min_distance,
+                    f"walked {m['distance_walked_m']} m, needed {e.min_distance} m"))
+    if e.max_reaction is not None:
+        r = m["max_reaction_s"]
+        out.append(("max_reaction", r is not None and r <= e.max_reaction,
+                    f"slowest reaction {r} s, limit {e.max_reaction} s" if r is not None else "no stimulus was answered"))
+    if e.stay_out is not None:
+        t = m["entered_forbidden_s"]
+        out.append(("stay_out", t is None, "never entered the region" if t is None else f"entered the region at {t} s"))
+    return out

@@ -1,0 +1,226 @@
+"""The robot body, its six legs and their servos; the body moves with its stance feet.
+
+Feet are kinematic points: a foot on the ground stays where it touched down
+(its anchor), and each physics step the body pose is the least-squares rigid
+transform that best keeps the stance feet on their anchors. The chassis is a
+pymunk shape, used only to detect contact with walls and tall obstacles: a
+move into one is refused (the feet slip). A swing foot that runs into a solid
+taller than itself stops there and its servos draw stall current (seed 6.1).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import pymunk
+
+from sim2d.geometry import Pt, convex_hull, inside_convex, rigid_fit, to_world
+from sim2d.kinematics import fk, ik
+from sim2d.robot_params import RobotParams
+from sim2d.world import BODY, OBSTACLE, WALL, World
+
+CONTACT_EPS = 0.002   # a foot within 2 mm of the ground touches it
+LEG_REACH = 0.45      # body centre to the farthest foot, with margin
+
+
+@dataclass
+class Joint:
+    angle: float
+    target: float
+    current: float = 0.0
+    speed: float = 0.0
+    powered: bool = True
+    rate: float = math.inf      # commanded speed (rad/s); the servo's own limit still applies
+
+
+@dataclass
+class Leg:
+    index: int
+    joints: list[Joint]
+    foot: tuple[float, float, float] = (0.0, 0.0, 0.0)   # body frame + height
+    world: Pt = (0.0, 0.0)
+    contact: bool = False
+    anchor: Pt | None = None
+    blocked: bool = False
+    over_pit: bool = False
+
+    @property
+    def powered(self) -> bool:
+        return all(j.powered for j in self.joints)
+
+
+@dataclass
+class Events:
+    collisions: int = 0
+    colliding: bool = False
+    blocked_legs: int = 0
+    pit_feet: int = 0
+    unstable_steps: int = 0
+    fell: bool = False
+    contact_points: list[Pt] = field(default_factory=list)
+
+
+def _ccw(pts: list[Pt]) -> list[Pt]:
+    (ax, ay), (bx, by), (cx, cy) = pts
+    return pts if (bx - ax) * (cy - ay) - (by - ay) * (cx - ax) > 0 else [pts[0], pts[2], pts[1]]
+
+
+class Robot:
+    def __init__(self, p: RobotParams, world: World, pose: tuple[float, float, float]):
+        self.p = p
+        self.world = world
+        self.pose = pose
+        self.events = Events()
+        self.legs: dict[int, Leg] = {}
+        for i in p.legs:
+            nx, ny = p.neutral_foot(i)
+            q = ik(p, i, nx, ny, 0.0)
+            self.legs[i] = Leg(i, [Joint(a, a) for a in q])
+            self._update_foot(self.legs[i])
+            self.legs[i].contact = True
+            self.legs[i].anchor = self.legs[i].world
+        self.charge_used_ah = 0.0
+        self.current = 0.0
+        self.body = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+        half_l, half_w = p.body_length / 2, p.body_width / 2
+        self.outline_body = [(half_l, half_w), (-half_l, half_w), (-half_l, -half_w), (half_l, -half_w)]
+        self.shape = pymunk.Poly(self.body, self.outline_body)
+        self.shape.filter = pymunk.ShapeFilter(categories=BODY, mask=WALL | OBSTACLE)
+        world.space.add(self.body, self.shape)
+        self._place(pose)
+
+    # --- helpers -----------------------------------------------------------
+    def outline(self) -> list[Pt]:
+        return [to_world(self.pose, x, y) for x, y in self.outline_body]
+
+    def _place(self, pose: tuple[float, float, float]) -> None:
+        self.body.position = (pose[0], pose[1])
+        self.body.angle = pose[2]
+        self.world.space.reindex_shapes_for_body(self.body)
+
+    def _update_foot(self, leg: Leg) -> None:
+        q1, q2, q3 = (j.angle for j in leg.joints)
+        leg.foot = fk(self.p, leg.index, q1, q2, q3)
+        leg.world = to_world(self.pose, leg.foot[0], leg.foot[1])
+
+    def _collides(self) -> bool:
+        for hit in self.world.space.shape_query(self.shape):
+            if self.world.heights.get(hit.shape, 0.0) > self.p.body_clearance:
+                return True
+        return False
+
+    def set_joint_target(self, leg: int, joint: int, angle: float, rate: float = math.inf) -> None:
+        j = self.legs[leg].joints[joint - 1]
+        j.target, j.rate = angle, rate
+
+    # --- one physics step -----------------------------------------------------
+    def step(self, dt: float) -> None:
+        if self.events.fell:
+            return
+        p = self.p
+        max_step = p.servo_speed * dt
+        total_current = p.electronics_a
+        near_solid, near_ground = self.world.near(self.pose[0], self.pose[1], LEG_REACH)
+        near = near_solid or near_ground
+        for leg in self.legs.values():
+            if not leg.powered:
+                leg.contact, leg.anchor = False, None      # an unpowered leg folds up (CHOICE)
+                for j in leg.joints:
+                    j.current = j.speed = 0.0
+                continue
+            old = [j.angle for j in leg.joints]
+            moving = False
+            for j in leg.joints:
+                err = j.target - j.angle
+                lim = max_step if j.rate * dt > max_step else j.rate * dt
+                d = err if abs(err) <= lim else math.copysign(lim, err)
+                j.angle += d
+                j.speed = d / dt
+                moving = moving or abs(d) > 1e-9
+            if not moving and not leg.blocked:
+                for j in leg.joints:
+                    j.current = p.servo_idle_a
+                total_current += 3 * p.servo_idle_a
+                continue
+            old_foot, old_world = leg.foot, leg.world
+            self._update_foot(leg)
+            fz = leg.foot[2]
+            leg.blocked = False
+            was = leg.contact
+            if not near or (fz > self.world.max_ground + CONTACT_EPS and not near_solid):
+                ground = 0.0                      # fast path: nothing around can touch this foot
+                leg.over_pit = False
+            else:
+                wx, wy = leg.world
+                ground = self.world.ground_height(wx, wy)
+                if not was and moving and self.world.has_solids:
+                    solid = self.world.solid_height_at(wx, wy)
+                    # from the side (the foot was below the top before): it hits the obstacle;
+                    # from above: it lands on top (contact below)
+                    if solid > fz + CONTACT_EPS and old_foot[2] < solid - CONTACT_EPS:
+                        # seed 6.1: the swing foot hits an obstacle; the servos stall
+                        for j, a in zip(leg.joints, old):
+                            j.angle, j.speed = a, 0.0
+                        leg.foot, leg.world = old_foot, old_world
+                        leg.blocked = True
+                        self.events.blocked_legs += 1
+                leg.over_pit = ground is None
+            leg.contact = ground is not None and leg.foot[2] <= ground + CONTACT_EPS
+            if leg.contact and not was:
+                leg.anchor = leg.world
+            elif not leg.contact:
+                leg.anchor = None
+            if leg.over_pit and leg.foot[2] <= CONTACT_EPS:
+                self.events.pit_feet += 1
+            for j in leg.joints:
+                if leg.blocked and abs(j.target - j.angle) > 1e-6:
+                    j.current = p.servo_stall_a
+                elif abs(j.speed) > 1e-9:
+                    j.current = p.servo_move_a
+                else:
+                    j.current = p.servo_idle_a
+                total_current += j.current
+        self._move_body()
+        self.current = total_current
+        self.charge_used_ah += total_current * dt / 3600.0
+
+    def _move_body(self) -> None:
+        stance = [leg for leg in self.legs.values() if leg.contact and leg.anchor is not None]
+        if len(stance) < 3:
+            self.events.unstable_steps += 1
+            self._check_fall()
+            return
+        anchors = [leg.anchor for leg in stance]
+        hull = _ccw(anchors) if len(anchors) == 3 else convex_hull(anchors)
+        new = rigid_fit([(leg.foot[0], leg.foot[1]) for leg in stance], [leg.anchor for leg in stance])
+        if not inside_convex(new[0], new[1], hull):
+            self.events.unstable_steps += 1
+            self._check_fall()
+            return
+        old = self.pose
+        self.pose = new
+        self._place(new)
+        if self._collides():
+            self.pose = old
+            self._place(old)
+            if not self.events.colliding:
+                self.events.collisions += 1
+            self.events.colliding = True
+            for leg in stance:            # the feet slip: re-anchor where they are now
+                leg.world = to_world(old, leg.foot[0], leg.foot[1])
+                leg.anchor = leg.world
+        else:
+            self.events.colliding = False
+        for leg in self.legs.values():
+            leg.world = to_world(self.pose, leg.foot[0], leg.foot[1])
+
+    def _check_fall(self) -> None:
+        """The body drops into a pit when it is over one without support."""
+        if self.world.in_pit(self.pose[0], self.pose[1]):
+            self.events.fell = True
+
+    # --- proprioception ---------------------------------------------------------
+    def battery_voltage(self) -> float:
+        p = self.p
+        soc = max(0.0, 1.0 - self.charge_used_ah / p.battery_ah)
+        return p.battery_empty_v + (p.battery_full_v - p.battery_empty_v) * soc - p.battery_r_ohm * self.current

@@ -1,0 +1,77 @@
+"""Run scenarios and write their output folders (atomically: temp dir, then rename)."""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from sim2d.metrics import check_expectations
+from sim2d.scenario import Scenario, load_scenario
+from sim2d.sim import Result, Simulation, trace_lines
+
+GIF_FRAME_S = 0.5
+
+
+@dataclass
+class Outcome:
+    scenario: Scenario
+    result: Result
+    expectations: list[tuple[str, bool, str]]
+
+    @property
+    def failed(self) -> list[tuple[str, bool, str]]:
+        return [e for e in self.expectations if not e[1]]
+
+
+def load_spec_once() -> Any:
+    from codegen.model import load_spec
+    return load_spec()
+
+
+def run(path: str, seed: int | None = None, spec: Any = None, gif: bool = False) -> Outcome:
+    spec = spec or load_spec_once()
+    sc = load_scenario(path, spec)
+    if seed is not None:
+        sc = sc.with_seed(seed)
+    sim = Simulation(sc, spec, keep_frames_every=GIF_FRAME_S if gif else None)
+    result = sim.run()
+    result.codec = sim.codec  # type: ignore[attr-defined]
+    result.spec = spec        # type: ignore[attr-defined]
+    return Outcome(sc, result, check_expectations(sc, result.metrics))
+
+
+def write_outputs(outcome: Outcome, out_dir: str | Path, gif: bool = False) -> Path:
+    """trace.tsv, metrics.json, run.png (and run.gif) into out_dir, replacing it whole."""
+    from sim2d.render import render_gif, render_png
+
+    out = Path(out_dir)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+    try:
+        r = outcome.result
+        lines = trace_lines(r.frames, r.spec, r.codec)  # type: ignore[attr-defined]
+        with open(tmp / "trace.tsv", "w") as fh:
+            fh.write("start_s\tend_s\tbus\tsender\tsrc\tdst\tmessage\tbytes\tflags\n")
+            fh.write("\n".join(lines) + ("\n" if lines else ""))
+        metrics = dict(r.metrics)
+        metrics["expectations"] = [{"name": n, "passed": ok, "detail": d} for n, ok, d in outcome.expectations]
+        (tmp / "metrics.json").write_text(json.dumps(metrics, indent=2) + "\n")
+        render_png(r, str(tmp / "run.png"))
+        if gif:
+            render_gif(r, str(tmp / "run.gif"))
+        os.chmod(tmp, 0o755)
+        if out.exists():
+            shutil.rmtree(out)
+        os.replace(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return out
+
+
+def default_out(outcome: Outcome) -> Path:
+    return Path("sim-out") / f"{outcome.scenario.name}-seed{outcome.scenario.seed}"

@@ -1,0 +1,283 @@
+"""Scenario files: YAML in, a checked, immutable Scenario out.
+
+Errors are one line, `file:line: message`. A scenario may `include:` shared
+definitions: included files come first, list-valued world keys (walls,
+obstacles, ...) are concatenated, mapping keys (arena, robot, expect) merge
+key by key, and the including file wins on conflicts.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from arachnae.errors import UserError, located
+from sim2d.schema import Bool, Key, List, Map, Num, Point, Polygon, Src, Str, fail
+
+TASKS = ("forward", "wall_follow", "seek_light", "avoid_light", "explore", "idle")  # SPEC-NOTES decision 8
+VERDICTS = ("OPERATIONAL", "DEGRADED", "HALTED")                                  # SPEC-NOTES decision 3
+LIST_KEYS = ("walls", "obstacles", "pits", "slopes", "lights", "heat", "sounds", "faults")
+MAP_KEYS = ("arena", "robot", "expect")
+
+
+@dataclass(frozen=True)
+class Obstacle:
+    polygon: tuple[tuple[float, float], ...]
+    height: float
+
+
+@dataclass(frozen=True)
+class Slope:
+    polygon: tuple[tuple[float, float], ...]
+    incline_x: float   # degrees, rising along +x
+    incline_y: float   # degrees, rising along +y
+
+
+@dataclass(frozen=True)
+class Light:
+    pos: tuple[float, float]
+    intensity: float   # candela: lux = intensity / d^2
+
+
+@dataclass(frozen=True)
+class Heat:
+    pos: tuple[float, float]
+    temperature: float  # degrees C at the source
+    radius: float       # metres to fall to 1/e of the excess
+
+
+@dataclass(frozen=True)
+class Sound:
+    at: float
+    pos: tuple[float, float]
+    level_db: float
+
+
+@dataclass(frozen=True)
+class Fault:
+    at: float
+    until: float | None
+    kind: str                 # kill | mute | bus
+    node: str | None = None
+    bus: str | None = None
+    loss: float = 0.0
+    corrupt: float = 0.0
+    delay: float = 0.0
+
+
+@dataclass(frozen=True)
+class Expectations:
+    post: str | None = None
+    no_collision: bool = False
+    reach: tuple[tuple[tuple[float, float], ...], float] | None = None   # (region, within seconds)
+    min_clearance: float | None = None
+    never_moves: bool = False
+    min_distance: float | None = None
+    max_reaction: float | None = None   # seed 5.2: stimulus -> reaction within this many seconds
+    stay_out: tuple[tuple[float, float], ...] | None = None           # the body centre never enters
+
+
+@dataclass(frozen=True)
+class Scenario:
+    path: str
+    name: str
+    duration: float
+    seed: int
+    size: tuple[float, float]
+    boundary_walls: bool
+    ambient_lux: float
+    ambient_temp: float
+    walls: tuple[tuple[tuple[float, float], ...], ...]
+    obstacles: tuple[Obstacle, ...]
+    pits: tuple[tuple[tuple[float, float], ...], ...]
+    slopes: tuple[Slope, ...]
+    lights: tuple[Light, ...]
+    heat: tuple[Heat, ...]
+    sounds: tuple[Sound, ...]
+    start: tuple[float, float, float]   # x, y, heading in radians
+    task: str
+    absent: tuple[str, ...]
+    faults: tuple[Fault, ...]
+    expect: Expectations = field(default_factory=Expectations)
+
+    def with_seed(self, seed: int) -> "Scenario":
+        from dataclasses import replace
+        return replace(self, seed=seed)
+
+
+def _fault_check(d: dict) -> str | None:
+    kinds = [k for k in ("kill", "mute", "bus") if d[k] is not None]
+    if len(kinds) != 1:
+        return "a fault names exactly one of kill, mute or bus"
+    if kinds[0] == "bus" and not (d["loss"] or d["corrupt"] or d["delay"]):
+        return "a bus fault needs loss, corrupt or delay"
+    if kinds[0] != "bus" and (d["loss"] or d["corrupt"] or d["delay"]):
+        return "loss, corrupt and delay belong to a bus fault"
+    if d["until"] is not None and d["until"] <= d["at"]:
+        return "until must be after at"
+    return None
+
+
+def _schemas(spec: Any) -> dict[str, Any]:
+    names = [n.short for n in spec.nodes] if spec is not None else None
+    buses = sorted(spec.buses) if spec is not None else None
+    node = Str(choices=names)
+    prob = Num(0.0, 1.0)
+    return {
+        "name": Str(),
+        "duration": Num(positive=True, hi=3600),
+        "seed": Num(0, 2**63 - 1, integer=True),
+        "arena": Map({
+            "size": Key(Point(), required=True),
+            "boundary_walls": Key(Bool(), default=True),
+            "ambient_lux": Key(Num(0.0), default=20.0),
+            "ambient_temp": Key(Num(-20, 100), default=20.0),
+        }, check=lambda d: None if d["size"][0] > 0 and d["size"][1] > 0 else "size must be positive"),
+        "walls": List(List(Point(), 2)),
+        "obstacles": List(Map({"polygon": Key(Polygon(), True), "height": Key(Num(positive=True), True)})),
+        "pits": List(Map({"polygon": Key(Polygon(), True)})),
+        "slopes": List(Map({"polygon": Key(Polygon(), True), "incline_x": Key(Num(-80, 80), default=0.0),
+                            "incline_y": Key(Num(-80, 80), default=0.0)})),
+        "lights": List(Map({"pos": Key(Point(), True), "intensity": Key(Num(positive=True), True)})),
+        "heat": List(Map({"pos": Key(Point(), True), "temperature": Key(Num(-20, 500), True),
+                          "radius": Key(Num(positive=True), default=0.5)})),
+        "sounds": List(Map({"at": Key(Num(0.0), True), "pos": Key(Point(), True), "level_db": Key(Num(0, 150), default=70.0)})),
+        "robot": Map({
+            "pose": Key(List(Num(), 3), required=True),
+            "task": Key(Str(TASKS), default="forward"),
+            "absent": Key(List(node), default=[]),
+        }, check=lambda d: None if len(d["pose"]) == 3 else "pose is [x, y, heading_deg]"),
+        "faults": List(Map({
+            "at": Key(Num(0.0), default=0.0), "until": Key(Num(0.0)),
+            "kill": Key(node), "mute": Key(node), "bus": Key(Str(choices=buses)),
+            "loss": Key(prob, default=0.0), "corrupt": Key(prob, default=0.0), "delay": Key(Num(0.0, 10.0), default=0.0),
+        }, check=_fault_check)),
+        "expect": Map({
+            "post": Key(Str(VERDICTS)),
+            "no_collision": Key(Bool(), default=False),
+            "reach": Key(Map({"region": Key(Polygon(), True), "within": Key(Num(positive=True), True)})),
+            "min_clearance": Key(Num(0.0)),
+            "never_moves": Key(Bool(), default=False),
+            "min_distance": Key(Num(0.0)),
+            "max_reaction": Key(Num(positive=True)),
+            "stay_out": Key(Polygon()),
+        }),
+    }
+
+
+def _compose(path: Path, shown: str) -> yaml.MappingNode:
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise UserError(located(shown, None, f"cannot read scenario ({exc.strerror})")) from None
+    try:
+        node = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        raise UserError(located(shown, mark.line + 1 if mark else None, f"invalid YAML: {exc.problem}")) from None
+    if node is None:
+        raise UserError(located(shown, None, "scenario is empty"))
+    if not isinstance(node, yaml.MappingNode):
+        raise UserError(located(shown, node.start_mark.line + 1, "a scenario is a mapping of keys"))
+    return node
+
+
+def _gather(path: Path, shown: str, stack: tuple[Path, ...], out: dict[str, list]) -> None:
+    """Collect (src, key node, value node) per top-level key, includes first."""
+    root = _compose(path, shown)
+    src = Src(shown)
+    items = root.value
+    for k, v in items:
+        if k.value == "include":
+            seq = v.value if isinstance(v, yaml.SequenceNode) else [v]
+            for inc in seq:
+                if not isinstance(inc, yaml.ScalarNode):
+                    raise fail(src, inc, "include: expected a file name")
+                target = (path.parent / inc.value).resolve()
+                if target in stack:
+                    raise fail(src, inc, f"include cycle through {inc.value}")
+                if not target.is_file():
+                    raise fail(src, inc, f"included file {inc.value!r} not found")
+                inc_shown = str(Path(shown).parent / inc.value)
+                _gather(target, inc_shown, stack + (target,), out)
+    for k, v in items:
+        if k.value != "include":
+            out.setdefault(str(k.value), []).append((src, k, v))
+
+
+def load_scenario(path: str | Path, spec: Any = None) -> Scenario:
+    """Read and check a scenario; `spec` (codegen.model) validates node and bus names."""
+    shown = str(path)
+    p = Path(path).resolve()
+    gathered: dict[str, list] = {}
+    _gather(p, shown, (p,), gathered)
+    schemas = _schemas(spec)
+    top_src, top_root = Src(shown), _compose(p, shown)
+    values: dict[str, Any] = {}
+    for key, entries in gathered.items():
+        if key not in schemas:
+            s, k, _ = entries[-1]
+            raise fail(s, k, f"unknown key {key!r} (expected one of include, {', '.join(schemas)})")
+        schema = schemas[key]
+        if key in LIST_KEYS:
+            values[key] = [x for s, _, v in entries for x in schema(s, v, key)]
+        elif key in MAP_KEYS:
+            pairs = []
+            for s, _, v in entries:
+                if not isinstance(v, yaml.MappingNode):
+                    raise fail(s, v, f"{key}: expected a mapping")
+                pairs.extend((s, kk, vv) for kk, vv in v.value)
+            values[key] = schema.convert(pairs, entries[-1][0], entries[-1][2], key)
+        else:
+            s, _, v = entries[-1]
+            values[key] = schema(s, v, key)
+    for key in ("duration", "arena", "robot"):
+        if key not in values:
+            raise fail(top_src, top_root, f"missing required key {key!r}")
+    sc = _build(values, shown)
+    x, y, _ = sc.start
+    if not (0 <= x <= sc.size[0] and 0 <= y <= sc.size[1]):
+        s, _, v = gathered["robot"][-1]
+        raise fail(s, v, f"robot: start pose ({x}, {y}) lies outside the arena {sc.size[0]} x {sc.size[1]} m")
+    return sc
+
+
+def _build(v: dict[str, Any], shown: str) -> Scenario:
+    arena, robot = v["arena"], v["robot"]
+    exp = v.get("expect") or {}
+    faults = tuple(
+        Fault(at=f["at"], until=f["until"], kind="kill" if f["kill"] else "mute" if f["mute"] else "bus",
+              node=f["kill"] or f["mute"], bus=f["bus"], loss=f["loss"], corrupt=f["corrupt"], delay=f["delay"])
+        for f in v.get("faults", [])
+    )
+    x, y, heading = robot["pose"]
+    return Scenario(
+        path=shown,
+        name=v.get("name") or Path(shown).stem,
+        duration=v["duration"],
+        seed=v.get("seed", 1),
+        size=arena["size"],
+        boundary_walls=arena["boundary_walls"],
+        ambient_lux=arena["ambient_lux"],
+        ambient_temp=arena["ambient_temp"],
+        walls=tuple(tuple(w) for w in v.get("walls", [])),
+        obstacles=tuple(Obstacle(o["polygon"], o["height"]) for o in v.get("obstacles", [])),
+        pits=tuple(p["polygon"] for p in v.get("pits", [])),
+        slopes=tuple(Slope(s["polygon"], s["incline_x"], s["incline_y"]) for s in v.get("slopes", [])),
+        lights=tuple(Light(tuple(li["pos"]), li["intensity"]) for li in v.get("lights", [])),
+        heat=tuple(Heat(tuple(h["pos"]), h["temperature"], h["radius"]) for h in v.get("heat", [])),
+        sounds=tuple(Sound(s["at"], tuple(s["pos"]), s["level_db"]) for s in v.get("sounds", [])),
+        start=(x, y, math.radians(heading)),
+        task=robot["task"],
+        absent=tuple(robot["absent"]),
+        faults=faults,
+        expect=Expectations(
+            post=exp.get("post"), no_collision=bool(exp.get("no_collision")),
+            reach=(exp["reach"]["region"], exp["reach"]["within"]) if exp.get("reach") else None,
+            min_clearance=exp.get("min_clearance"), never_moves=bool(exp.get("never_moves")),
+            min_distance=exp.get("min_distance"), max_reaction=exp.get("max_reaction"), stay_out=exp.get("stay_out"),
+        ),
+    )

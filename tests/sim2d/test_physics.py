@@ -1,0 +1,100 @@
+from __future__ import annotations
+
+import math
+
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from sim2d.gait import FORWARD, TURN_LEFT, Gait
+from sim2d.geometry import rigid_fit, to_world
+from sim2d.kinematics import fk, ik
+from sim2d.robot import Robot
+from sim2d.robot_params import DEFAULT as P
+from sim2d.scenario import load_scenario
+from sim2d.world import World
+
+
+@settings(max_examples=200, deadline=None)
+@given(leg=st.integers(1, 6), dx=st.floats(-0.05, 0.05), dy=st.floats(-0.03, 0.03), z=st.floats(0.0, 0.06))
+def test_ik_inverts_fk_in_the_workspace(leg, dx, dy, z):
+    nx, ny = P.neutral_foot(leg)
+    target = (nx + dx, ny + dy, z)
+    assert fk(P, leg, *ik(P, leg, *target)) == pytest.approx(target, abs=1e-9)
+
+
+@settings(max_examples=100, deadline=None)
+@given(x=st.floats(-5, 5), y=st.floats(-5, 5), th=st.floats(-3, 3))
+def test_rigid_fit_recovers_the_transform(x, y, th):
+    body = [(0.1, 0.2), (-0.12, 0.2), (0.0, -0.2)]
+    world = [to_world((x, y, th), *p) for p in body]
+    fx, fy, fth = rigid_fit(body, world)
+    assert (fx, fy) == pytest.approx((x, y), abs=1e-9)
+    assert math.remainder(fth - th, 2 * math.pi) == pytest.approx(0, abs=1e-9)
+
+
+def walk(path, command=FORWARD, seconds=10.0):
+    """Drive the legs straight from the gait (no network) and return the robot."""
+    sc = load_scenario(path)
+    world = World(sc)
+    robot = Robot(P, world, sc.start)
+    gait = Gait(P)
+    gait.set_command(command)
+    for _ in range(int(seconds / P.dt)):
+        gait.advance(P.dt)
+        for leg in P.legs:
+            for j, a in enumerate(ik(P, leg, *gait.target(leg))):
+                robot.set_joint_target(leg, j + 1, a)
+        robot.step(P.dt)
+    return robot
+
+
+ROOM = "duration: 20\narena: {size: [6, 4]}\nrobot: {pose: [1, 2, 0]}\n"
+
+
+def test_tripod_walks_straight_at_about_10_cm_per_s(write):
+    r = walk(write("s.yaml", ROOM))
+    x, y, th = r.pose
+    assert 0.8 < x - 1.0 < 1.1                       # seed 1.1: ~10 cm/s
+    assert abs(y - 2.0) < 0.02 and abs(th) < math.radians(2)
+    assert r.events.collisions == 0
+
+
+def test_turn_left_rotates_in_place(write):
+    r = walk(write("s.yaml", ROOM), TURN_LEFT, 5.0)
+    x, y, th = r.pose
+    assert th > math.radians(30) and math.hypot(x - 1, y - 2) < 0.05
+
+
+def test_high_obstacle_blocks_the_body_low_one_does_not(write):
+    high = ROOM + "obstacles: [{polygon: [[1.6, 1], [1.8, 1], [1.8, 3], [1.6, 3]], height: 0.15}]\n"
+    r = walk(write("h.yaml", high))
+    assert r.events.collisions >= 1 and r.pose[0] + P.body_length / 2 < 1.6 + 0.01
+    assert r.events.blocked_legs > 0                 # swing feet ran into it too (seed 6.1: stall current)
+    low = ROOM + "obstacles: [{polygon: [[1.6, 1], [1.62, 1], [1.62, 3], [1.6, 3]], height: 0.02}]\n"
+    r = walk(write("l.yaml", low))
+    assert r.events.collisions == 0 and r.pose[0] > 1.8
+
+
+def test_blocked_leg_draws_stall_current(write):
+    high = ROOM + "obstacles: [{polygon: [[1.3, 1], [1.5, 1], [1.5, 3], [1.3, 3]], height: 0.15}]\n"
+    r = walk(write("h.yaml", high), seconds=6.0)
+    currents = [j.current for leg in r.legs.values() for j in leg.joints]
+    assert r.events.blocked_legs > 0
+    assert max(currents) <= P.servo_stall_a
+
+
+def test_no_ground_over_a_pit(write):
+    pit = ROOM + "pits: [{polygon: [[1.5, 0.5], [3, 0.5], [3, 3.5], [1.5, 3.5]]}]\n"
+    r = walk(write("p.yaml", pit), seconds=12.0)
+    assert r.events.pit_feet > 0
+    over = [leg for leg in r.legs.values() if leg.over_pit]
+    assert all(not leg.contact for leg in over)
+
+
+def test_battery_drains_with_load(write):
+    sc = load_scenario(write("s.yaml", ROOM))
+    r = Robot(P, World(sc), sc.start)
+    v0 = r.battery_voltage()
+    r.current = 5.0
+    r.charge_used_ah = 0.5
+    assert r.battery_voltage() < v0 - 0.1
