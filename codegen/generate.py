@@ -73,9 +73,16 @@ def managed_dirs(languages: tuple[str, ...] = LANGUAGES) -> list[Path]:
     return [Path(importlib.import_module(f"codegen.templates.{lang}").OUT_DIR) for lang in languages]
 
 
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 def write(files: dict[Path, bytes], root: Path = REPO, languages: tuple[str, ...] = LANGUAGES) -> list[Path]:
     """Write the rendered tree; remove stale generated files; return the paths that changed."""
     changed: list[Path] = []
+    mode = 0o666 & ~_umask()  # mkstemp makes 0600 files; generated files are ordinary sources
     for rel, data in sorted(files.items()):
         target = root / rel
         if target.exists() and target.read_bytes() == data:
@@ -84,6 +91,7 @@ def write(files: dict[Path, bytes], root: Path = REPO, languages: tuple[str, ...
         fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=".gen-")
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
+        os.chmod(tmp, mode)
         os.replace(tmp, target)
         changed.append(rel)
     for out_dir in managed_dirs(languages):
