@@ -16,6 +16,19 @@ from typing import Iterator
 from codegen.encoding import MILLI, Encoding, Linear, Log10, to_fraction
 
 SPEC_DIR = Path(__file__).resolve().parent.parent / "spec"
+
+# The codecs' error kinds, in the order every codec checks them (C and Python share this list).
+ERROR_KINDS: tuple[tuple[str, str], ...] = (
+    ("OK", "success"),
+    ("TRUNCATED", "fewer bytes than header+crc, or than header+length+crc"),
+    ("OVERSIZE", "more bytes than the length byte says, or than the parser's buffer holds"),
+    ("CHECKSUM", "CRC mismatch"),
+    ("ADDRESS", "dst is neither the own address nor broadcast"),
+    ("OPCODE", "unknown opcode (or one the role does not receive)"),
+    ("LENGTH", "payload size not valid for the message, or an array count that disagrees with it"),
+    ("RANGE", "a field outside its raw range, enum or flags mask, or not a node address"),
+    ("BUFFER", "caller's output buffer too small"),
+)
 SPEC_FILES = ("nodes.yaml", "messages.yaml")
 
 
@@ -104,6 +117,8 @@ class Frame:
     max_payload: int
     checksum: Checksum
     section: str
+    byte_order: str = "big"
+    covers: tuple[str, ...] = ()
 
     @property
     def header_size(self) -> int:
@@ -422,7 +437,7 @@ def build(nodes_doc: dict, messages_doc: dict, sources: tuple[Path, ...], digest
     c = fdoc["checksum"]
     frame = Frame(tuple(fdoc["header"]), fdoc["max_payload"],
                   Checksum(c["name"], c["width"], c["poly"], c["init"], c["refin"], c["refout"], c["xorout"], c["check"]),
-                  fdoc["section"])
+                  fdoc["section"], byte_order=fdoc["byte_order"], covers=tuple(c["covers"]))
     enums = {k: Enum(k, dict(v["values"]), v["section"], dict(v.get("texts", {}))) for k, v in messages_doc["enums"].items()}
     flags = {k: Flags(k, dict(v["bits"]), v["section"]) for k, v in messages_doc["flags"].items()}
     messages = tuple(
@@ -457,5 +472,5 @@ def load_spec(spec_dir: Path | str | None = None) -> Spec:
     return build(nodes_doc, messages_doc, paths, spec_digest(paths))
 
 
-__all__ = ["Spec", "Node", "Bus", "Message", "Field", "Enum", "Flags", "Frame", "Checksum", "PostRules", "Protocol",
+__all__ = ["ERROR_KINDS", "Spec", "Node", "Bus", "Message", "Field", "Enum", "Flags", "Frame", "Checksum", "PostRules", "Protocol",
            "Quorum", "load_spec", "SPEC_DIR", "MILLI"]

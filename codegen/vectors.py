@@ -9,7 +9,6 @@ from __future__ import annotations
 from codegen.encoding import MILLI, Linear, Log10, round_half_away
 from codegen.model import Field, Message, Spec
 
-ERRORS = ("OK", "TRUNCATED", "OVERSIZE", "CHECKSUM", "ADDRESS", "OPCODE", "LENGTH", "RANGE", "BUFFER")
 
 
 def pack(message: Message, values: dict[str, object]) -> bytes:
@@ -239,4 +238,4 @@ def vector_text(spec: Spec) -> str:
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["vector_text", "pack", "frame", "ERRORS"]
+__all__ = ["vector_text", "pack", "frame"]

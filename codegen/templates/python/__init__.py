@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 from codegen.encoding import Linear, Log10
 from codegen.generate import Output
-from codegen.model import Field, Message, Spec
+from codegen.model import ERROR_KINDS, Field, Message, Spec
 
 OUT_DIR = "generated/python/arachnae_proto"
 COMMENT = "#"
@@ -189,7 +189,7 @@ def outputs(spec: Spec) -> list[Output]:
         routes[n.address] = {o.address: spec.shared_bus(n, o).name for o in spec.nodes  # type: ignore[union-attr]
                              if o is not n and spec.shared_bus(n, o) is not None}
     width = spec.frame.checksum.width
-    ctx = {"msgs": msgs, "roles": roles, "tables": log_tables(spec), "crc_fast": crc_fast(spec), "routes": routes,
+    ctx = {"errors": ERROR_KINDS, "msgs": msgs, "roles": roles, "tables": log_tables(spec), "crc_fast": crc_fast(spec), "routes": routes,
            "crc_shift": width - 8, "crc_top": 1 << (width - 1), "crc_mask": (1 << width) - 1}
     out = [
         Output("__init__.py", "init.py.j2", ctx),

@@ -5,15 +5,15 @@ import enum
 
 
 class ErrorKind(enum.IntEnum):
-    OK = 0
-    TRUNCATED = 1   # fewer bytes than the header, checksum and payload need
-    OVERSIZE = 2    # more bytes than the length byte says, or than the buffer holds
-    CHECKSUM = 3
-    ADDRESS = 4     # for another node: neither our address nor broadcast
-    OPCODE = 5      # no message has this opcode
-    LENGTH = 6      # payload size wrong for the message
-    RANGE = 7       # a field value the spec does not allow
-    BUFFER = 8      # caller's buffer too small
+    OK = 0  # success
+    TRUNCATED = 1  # fewer bytes than header+crc, or than header+length+crc
+    OVERSIZE = 2  # more bytes than the length byte says, or than the parser's buffer holds
+    CHECKSUM = 3  # CRC mismatch
+    ADDRESS = 4  # dst is neither the own address nor broadcast
+    OPCODE = 5  # unknown opcode (or one the role does not receive)
+    LENGTH = 6  # payload size not valid for the message, or an array count that disagrees with it
+    RANGE = 7  # a field outside its raw range, enum or flags mask, or not a node address
+    BUFFER = 8  # caller's output buffer too small
 
 
 class CodecError(ValueError):

@@ -1,0 +1,89 @@
+/*
+ * Drives the TPSC, JAC(1,1) and MMC skeletons with frames from a file.
+ * Usage: skeleton_test FILE, lines "<role> <frame_hex>". For each frame it prints
+ *   parser <STATUS>     the byte-at-a-time parser with the role's payload check
+ *   call ... / send ... what the behaviour callbacks saw and what the skeleton sent
+ *   status <STATUS>     the skeleton's dispatch result
+ * Then "accepts <role> <addresses...>": the own addresses node_init accepts.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "arachnae_generic.h"
+#include "node_jac.h"
+#include "node_mmc.h"
+#include "node_tpsc.h"
+
+static uint16_t parse_hex(const char *s, uint8_t *out, uint16_t cap)
+{
+    uint16_t n = 0;
+    while (s[0] != '\0' && s[1] != '\0' && n < cap) {
+        unsigned v;
+        if (sscanf(s, "%2x", &v) != 1)
+            break;
+        out[n++] = (uint8_t)v;
+        s += 2;
+    }
+    return n;
+}
+
+static arachnae_status run_parser(const uint8_t *frame, uint16_t n, uint16_t own, arachnae_payload_check_fn check,
+                                  uint16_t cap)
+{
+    uint8_t buf[ARACHNAE_MAX_FRAME];
+    arachnae_parser p;
+    arachnae_status verdict = ARACHNAE_NONE, st;
+    uint16_t i;
+    arachnae_parser_init(&p, buf, cap, own, check);
+    for (i = 0; i < n; i++)
+        if ((st = arachnae_parser_feed(&p, frame[i])) != ARACHNAE_NONE)
+            verdict = st;
+    if ((st = arachnae_parser_gap(&p)) != ARACHNAE_NONE)
+        verdict = st;
+    return verdict;
+}
+
+int main(int argc, char **argv)
+{
+    char line[1024], role[16], hex[700];
+    uint8_t frame[ARACHNAE_MAX_FRAME];
+    tpsc_node tpsc;
+    jac_node jac;
+    mmc_node mmc;
+    unsigned a;
+    FILE *fp;
+    if (argc != 2 || (fp = fopen(argv[1], "r")) == NULL)
+        return 2;
+    if (tpsc_node_init(&tpsc, ARACHNAE_ADDR_TPSC, NULL) != ARACHNAE_OK ||
+        jac_node_init(&jac, ARACHNAE_ADDR_JAC_1_1, NULL) != ARACHNAE_OK ||
+        mmc_node_init(&mmc, ARACHNAE_ADDR_MMC, NULL) != ARACHNAE_OK)
+        return 3;
+    while (fgets(line, sizeof line, fp) != NULL) {
+        uint16_t n;
+        arachnae_status st;
+        if (sscanf(line, "%15s %699s", role, hex) != 2)
+            continue;
+        n = parse_hex(hex, frame, sizeof frame);
+        if (strcmp(role, "tpsc") == 0) {
+            printf("parser %s\n", arachnae_status_name(run_parser(frame, n, tpsc.address, tpsc_payload_check, ARACHNAE_RX_MAX_TPSC)));
+            st = tpsc_dispatch(&tpsc, frame, n);
+        } else if (strcmp(role, "jac") == 0) {
+            printf("parser %s\n", arachnae_status_name(run_parser(frame, n, jac.address, jac_payload_check, ARACHNAE_RX_MAX_JAC)));
+            st = jac_dispatch(&jac, frame, n);
+        } else {
+            printf("parser %s\n", arachnae_status_name(run_parser(frame, n, mmc.address, mmc_payload_check, ARACHNAE_RX_MAX_MMC)));
+            st = mmc_dispatch(&mmc, frame, n);
+        }
+        printf("status %s\n", arachnae_status_name(st));
+    }
+    fclose(fp);
+    printf("accepts jac");
+    for (a = 0; a < 256u; a++) {
+        jac_node probe;
+        if (jac_node_init(&probe, (uint8_t)a, NULL) == ARACHNAE_OK)
+            printf(" %02x", a);
+    }
+    printf("\n");
+    return 0;
+}
