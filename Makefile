@@ -4,7 +4,7 @@ PY       := $(VENV)/bin/python
 ARACHNAE := $(VENV)/bin/arachnae
 STAMP    := $(VENV)/.setup-stamp
 
-.PHONY: setup run test scenarios codegen spec-check check bench clean
+.PHONY: setup run test scenarios codegen spec-check check bench firmware size fuzz clean
 
 setup: $(STAMP)
 
@@ -32,6 +32,16 @@ codegen: setup
 
 spec-check: setup
 	$(ARACHNAE) spec check
+
+## Firmware-grade C (issue 6): build matrix, size table, bounded fuzz campaign.
+firmware: setup
+	$(MAKE) -C firmware all PYTHON=$(abspath $(PY))
+
+size: setup
+	$(MAKE) -C firmware size PYTHON=$(abspath $(PY))
+
+fuzz: setup
+	$(MAKE) -C firmware fuzz PYTHON=$(abspath $(PY))
 
 ## Benchmarks print figures next to references measured in the same run.
 bench: setup

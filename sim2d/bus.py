@@ -78,9 +78,6 @@ class Port:
             self._pending = True
             self.bus._schedule_start(self)
 
-    def line_idle(self) -> bool:
-        return self.bus.idle()
-
     @property
     def sending(self) -> bool:
         return self._pending
@@ -112,6 +109,10 @@ class Bus:
 
     def idle(self) -> bool:
         return not self.active and self.sched.now >= self.idle_at
+
+    def idle_for(self) -> float:
+        """Seconds since the line went idle; 0.0 while a frame is on it."""
+        return self.sched.now - self.idle_at if not self.active and self.sched.now >= self.idle_at else 0.0
 
     def _schedule_start(self, port: Port) -> None:
         t = max(self.sched.now, self.idle_at + self.turnaround if self.idle_at > 0 else self.sched.now)

@@ -35,6 +35,15 @@ def build_metrics(sim: "Simulation") -> dict[str, Any]:
         st = b.stats
         buses[name] = {"load": round(st.busy_s / dur, 4), "frames": st.frames, "bytes": st.bytes,
                        "collisions": st.collisions, "lost": st.lost, "corrupted": st.corrupted, "delayed": st.delayed}
+    layers: dict[str, dict[str, Any]] = {}
+    for name, b in buses.items():      # seed 3.2.1: level 0 first-level bus, 1 leg/sensor buses, 2 joint buses
+        layer = layers.setdefault(str(sim.spec.buses[name].level), {"buses": [], "frames": 0, "lost": 0, "corrupted": 0})
+        layer["buses"].append(name)
+        for k in ("frames", "lost", "corrupted"):
+            layer[k] += b[k]
+    for layer in layers.values():
+        loads = [buses[n]["load"] for n in layer["buses"]]
+        layer["load_mean"], layer["load_max"] = round(sum(loads) / len(loads), 4), max(loads)
     v = sim.verdict
     lat = reaction_latencies(sim.stimuli, sim.moves, sim.escapes)
     ev = sim.robot.events
@@ -62,8 +71,10 @@ def build_metrics(sim: "Simulation") -> dict[str, Any]:
         "reaction_latencies_s": lat,
         "max_reaction_s": max(lat) if lat else None,
         "buses": buses,
+        "bus_layers": dict(sorted(layers.items())),
         "frames": len(sim.frames),
         "frame_loss": sum(b["lost"] for b in buses.values()),
+        "frames_corrupted": sum(b["corrupted"] for b in buses.values()),
         "battery_v": round(sim.robot.battery_voltage(), 3),
         "trace_hash": trace_hash(sim.frames, sim.poses),
     }

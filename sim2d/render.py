@@ -8,6 +8,7 @@ from PIL import Image, ImageDraw
 from sim2d.geometry import to_world
 
 MAX_PX = 900
+PATH, SONAR, IR, WHISKER, ROBOT = (0, 120, 255), (160, 0, 160), (255, 120, 0), (220, 0, 0), (30, 90, 200)
 
 
 class _View:
@@ -58,7 +59,17 @@ def _robot(draw: ImageDraw.ImageDraw, v: _View, pose: tuple[float, float, float]
     draw.line([v.px(to_world(pose, hl, 0)), v.px(nose)], fill=(200, 0, 0), width=2)
 
 
+def _legend(draw: ImageDraw.ImageDraw, v: _View) -> None:
+    x, y = 26, v.h - 16
+    for colour, label in ((PATH, "trajectory"), (ROBOT, "final pose"), (SONAR, "sonar returns"),
+                          (IR, "IR rays / echoes"), (WHISKER, "whisker contacts")):
+        draw.rectangle([x, y, x + 10, y + 8], fill=colour)
+        draw.text((x + 14, y - 2), label, fill=(0, 0, 0))
+        x += 24 + 7 * len(label)
+
+
 def render_png(result: Any, path: str) -> None:
+    """World, trajectory, final pose, sonar returns, IR rays and whisker contacts (issue 4)."""
     sc, robot, log = result.scenario, result.robot, result.sensors.log
     v = _View(sc.size)
     img = Image.new("RGB", (v.w, v.h), (255, 255, 255))
@@ -66,18 +77,23 @@ def render_png(result: Any, path: str) -> None:
     _world(d, v, sc, robot.p.step_limit)
     if sc.expect.reach is not None:
         d.polygon([v.px(p) for p in sc.expect.reach[0]], outline=(0, 160, 0), width=2)
-    for _, pt in log.sonar[-2000:]:
+    for _, pt in log.sonar[-4000:]:
         x, y = v.px(pt)
-        d.point([(x, y)], fill=(160, 0, 160))
+        d.ellipse([x - 1.5, y - 1.5, x + 1.5, y + 1.5], fill=SONAR)
     path_px = [v.px((x, y)) for _, x, y, _ in result.poses]
     if len(path_px) > 1:
-        d.line(path_px, fill=(0, 120, 255), width=2)
-    for a, b, hit in log.ir_rays:
-        d.line([v.px(a), v.px(b)], fill=(255, 0, 0) if hit else (255, 150, 150), width=1)
+        d.line(path_px, fill=PATH, width=2)
+    for a, b in log.ir_hits[-2000:]:
+        d.line([v.px(a), v.px(b)], fill=IR, width=1)
+        x, y = v.px(b)
+        d.ellipse([x - 2, y - 2, x + 2, y + 2], fill=IR)
+    _robot(d, v, robot.pose, [leg.world for leg in robot.legs.values()], robot.p)
+    for a, b, hit in log.ir_rays:                      # the last IR measurement, at the final pose
+        d.line([v.px(a), v.px(b)], fill=IR if hit else (255, 190, 140), width=2)
     for _, pt in log.whisker_hits:
         x, y = v.px(pt)
-        d.ellipse([x - 3, y - 3, x + 3, y + 3], outline=(255, 0, 0))
-    _robot(d, v, robot.pose, [leg.world for leg in robot.legs.values()], robot.p)
+        d.ellipse([x - 4, y - 4, x + 4, y + 4], outline=WHISKER, width=2)
+    _legend(d, v)
     m = result.metrics
     d.text((24, 4), f"{sc.name} seed {sc.seed}  POST {m['post']['verdict']}  walked {m['distance_walked_m']:.2f} m  "
                     f"collisions {m['collisions']}", fill=(0, 0, 0))

@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 
 import pymunk
 
+from behaviours.kinematics import fk, ik
 from sim2d.geometry import Pt, convex_hull, inside_convex, rigid_fit, to_world
-from sim2d.kinematics import fk, ik
 from sim2d.robot_params import RobotParams
 from sim2d.world import BODY, OBSTACLE, WALL, World
 

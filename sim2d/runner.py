@@ -39,8 +39,6 @@ def run(path: str, seed: int | None = None, spec: Any = None, gif: bool = False)
         sc = sc.with_seed(seed)
     sim = Simulation(sc, spec, keep_frames_every=GIF_FRAME_S if gif else None)
     result = sim.run()
-    result.codec = sim.codec  # type: ignore[attr-defined]
-    result.spec = spec        # type: ignore[attr-defined]
     return Outcome(sc, result, check_expectations(sc, result.metrics))
 
 
@@ -53,7 +51,7 @@ def write_outputs(outcome: Outcome, out_dir: str | Path, gif: bool = False) -> P
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
     try:
         r = outcome.result
-        lines = trace_lines(r.frames, r.spec, r.codec)  # type: ignore[attr-defined]
+        lines = trace_lines(r.frames)
         with open(tmp / "trace.tsv", "w") as fh:
             fh.write("start_s\tend_s\tbus\tsender\tsrc\tdst\tmessage\tbytes\tflags\n")
             fh.write("\n".join(lines) + ("\n" if lines else ""))

@@ -1,15 +1,15 @@
-"""Sensor physics: read the world around the robot and return raw wire values.
+"""Sensor physics: read the world around the robot, in physical units.
 
 Each read is done only when a node asks (a ray cast per ping, never per
-step). Values are quantised by sim2d.encodings exactly as the spec encodes
-them; noise comes from a named stream per sensor (sim2d.rng).
+step). Readings carry the sensor's own noise and resolution; quantising
+them into the spec's wire encodings is the sensor controller's firmware
+(behaviours.sensors). Noise comes from a named stream per sensor (sim2d.rng).
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
 
-from sim2d import encodings as enc
 from sim2d.geometry import Pt, to_world
 from sim2d.rng import stream
 from sim2d.robot import Robot
@@ -22,6 +22,7 @@ class SensorLog:
 
     sonar: list[tuple[float, Pt]] = field(default_factory=list)          # (t, echo point)
     ir_rays: list[tuple[Pt, Pt, bool]] = field(default_factory=list)     # last IR beams: start, end, hit
+    ir_hits: list[tuple[Pt, Pt]] = field(default_factory=list)          # every beam that hit: start, echo point
     whisker_hits: list[tuple[float, Pt]] = field(default_factory=list)
 
 
@@ -32,8 +33,8 @@ class Sensors:
         self.log = SensorLog()
 
     # seed 3.2.11: 40 kHz transducer on a head turning 360 deg in 1 deg steps, range 10 m
-    def usrc_ping(self, head_deg: int, t: float = 0.0) -> tuple[int, float]:
-        """Raw distance byte and time of flight (s) of one ping with the head at `head_deg` (body frame)."""
+    def usrc_ping(self, head_deg: int, t: float = 0.0) -> tuple[float | None, float]:
+        """Echo distance in m (None: no echo in range) and time of flight (s), head at `head_deg` (body frame)."""
         p = self.p
         x, y, th = self.robot.pose
         base = th + math.radians(head_deg % 360)
@@ -46,13 +47,14 @@ class Sensors:
             if hit is not None and (best is None or hit[0] < best[0]):
                 best = hit
         if best is None:
-            return 255, 2 * p.us_range / p.sound_speed
+            return None, 2 * p.us_range / p.sound_speed
         d = max(0.0, best[0] + self.rng["usrc"].gauss(0.0, p.us_noise_m))
         self.log.sonar.append((t, best[1]))
-        return enc.usrc_distance(d), 2 * best[0] / p.sound_speed
+        return d, 2 * best[0] / p.sound_speed
 
     # seed 3.2.13: three IR beams, 0 deg and +-15 deg, range 10 cm
-    def irrc(self) -> tuple[int, ...]:
+    def irrc(self) -> tuple[float | None, ...]:
+        """Distance in m of each beam (left, centre, right); None: nothing within range."""
         p = self.p
         th = self.robot.pose[2]
         origin = to_world(self.robot.pose, p.body_length / 2, 0.0)
@@ -61,12 +63,13 @@ class Sensors:
             a = th + math.radians(deg)
             hit = self.world.ray(origin, a, p.ir_range, p.ir_height)
             if hit is None:
-                out.append(255)
+                out.append(None)
                 rays.append((origin, (origin[0] + p.ir_range * math.cos(a), origin[1] + p.ir_range * math.sin(a)), False))
             else:
                 d = max(0.0, hit[0] + self.rng["irrc"].gauss(0.0, p.ir_noise_m))
-                out.append(enc.irrc_distance(d))
+                out.append(d)
                 rays.append((origin, hit[1], True))
+                self.log.ir_hits.append((origin, hit[1]))
         self.log.ir_rays = rays
         return tuple(out)
 
@@ -83,24 +86,24 @@ class Sensors:
             res.append(hit is not None)
         return res[0], res[1]
 
-    def tpsc(self, t: float = 0.0) -> int:
-        return enc.tpsc_whiskers(*self.whiskers(t))
-
     def foot_contact(self, leg: int) -> bool:
         """Sole switch (seed 1.2.2): no contact over a pit."""
         return self.robot.legs[leg].contact
 
     # seed 3.2.14: channel 0 longitudinal, 1 transverse, -60..60 deg, +-3 deg
-    def isc(self) -> tuple[int, int]:
+    def isc(self) -> tuple[float, float]:
+        """(longitudinal, transverse) degrees in the sensor's steps, within its range."""
         x, y, th = self.robot.pose
         ix, iy = self.world.incline(x, y)
         gx, gy = math.tan(math.radians(ix)), math.tan(math.radians(iy))
         pitch = math.degrees(math.atan(gx * math.cos(th) + gy * math.sin(th)))
         roll = math.degrees(math.atan(-gx * math.sin(th) + gy * math.cos(th)))
         r = self.rng["isc"]
-        step = self.p.isc_step_deg
-        return (enc.isc_inclination(pitch + r.gauss(0.0, step / 3), step),
-                enc.isc_inclination(roll + r.gauss(0.0, step / 3), step))
+        step, top = self.p.isc_step_deg, self.p.isc_max_deg
+
+        def resolve(deg: float) -> float:
+            return max(-top, min(top, step * round(deg / step)))
+        return resolve(pitch + r.gauss(0.0, step / 3)), resolve(roll + r.gauss(0.0, step / 3))
 
     def tilt_deg(self) -> float:
         """True (noise-free) inclination magnitude under the body, for the metrics."""
@@ -108,24 +111,26 @@ class Sensors:
         return math.degrees(math.atan(math.hypot(math.tan(math.radians(ix)), math.tan(math.radians(iy)))))
 
     # seed 3.2.15: 8 channels, int8 degrees C, -20..100
-    def tsc(self) -> tuple[int, ...]:
+    def tsc(self) -> tuple[float, ...]:
         """CHOICE: the 8 probes sit around the body rim at 45 degree steps, channel 0 at the front."""
         p = self.p
         out = []
         for ch in range(p.tsc_channels):
             a = 2 * math.pi * ch / p.tsc_channels
             px, py = to_world(self.robot.pose, p.body_length / 2 * math.cos(a), p.body_width / 2 * math.sin(a))
-            out.append(enc.tsc_temperature(self.world.temperature(px, py) + self.rng["tsc"].gauss(0.0, p.tsc_noise_c)))
+            out.append(self.world.temperature(px, py) + self.rng["tsc"].gauss(0.0, p.tsc_noise_c))
         return tuple(out)
 
     # seed 3.2.16: logarithmic light sensor on top of the body
-    def lsc(self) -> int:
+    def lsc(self) -> float:
+        """Lux at the sensor."""
         lux = self.world.lux(self.robot.pose[0], self.robot.pose[1])
-        return enc.lsc_light(lux * (1.0 + self.rng["lsc"].gauss(0.0, self.p.lsc_noise_rel)))
+        return lux * (1.0 + self.rng["lsc"].gauss(0.0, self.p.lsc_noise_rel))
 
     # seed 3.2.17: battery voltage
-    def psc(self) -> int:
-        return enc.psc_voltage(self.robot.battery_voltage() + self.rng["psc"].gauss(0.0, 0.005))
+    def psc(self) -> float:
+        """Battery volts."""
+        return self.robot.battery_voltage() + self.rng["psc"].gauss(0.0, 0.005)
 
     # seed 3.2.18: position (potentiometer), speed (tacho), plus motor current (seed 6.1)
     def joint(self, leg: int, joint: int) -> tuple[float, float, float]:

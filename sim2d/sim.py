@@ -1,8 +1,13 @@
-"""The simulation: world, robot, sensors, buses and the 39 node processes on one clock.
+"""The simulation: world, robot, sensors, buses and the 39 nodes on one clock.
 
-One discrete-event scheduler drives everything: the physics step is a
-periodic event (fixed dt), bus frames are events at their start and end,
-node timers are events. Nothing is stepped per bit or per byte.
+Every node is its behaviour class (behaviours/, a subclass of the generated
+skeleton) on a simulated board (sim2d.hardware). Nodes exchange BYTES: a
+node's skeleton frames a message with the generated codec and hands the
+bytes to its bus port; the bus delivers bytes to every station, whose
+skeleton parses them (arachnae_proto.frame). One discrete-event scheduler
+drives everything: the physics step is a periodic event (fixed dt), bus
+frames are events at their start and end, node timers are events. Nothing
+is stepped per bit or per byte.
 """
 from __future__ import annotations
 
@@ -11,14 +16,18 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-from sim2d import encodings
-from sim2d.behaviours import behaviour
-from sim2d.behaviours.base import NodeProcess
+from arachnae_proto import CodecError
+from arachnae_proto.frame import check, parse
+from arachnae_proto.network import BROADCAST, name_of
+
+from behaviours import behaviour_class
+from behaviours.netconfig import Config, NetConfig
+from behaviours.post import Verdict
+from behaviours.runtime import Runtime
 from sim2d.bus import Bus, Fault as BusFault, TraceEntry
-from sim2d.codec import Codec, Decoded
 from sim2d.events import Scheduler
 from sim2d.geometry import point_in_polygon
-from sim2d.post import Verdict
+from sim2d.hardware import NodeHardware
 from sim2d.rng import stream
 from sim2d.robot import Robot
 from sim2d.robot_params import DEFAULT, RobotParams
@@ -48,73 +57,59 @@ class Result:
     frames_png: list = field(default_factory=list)
 
 
-class Context:
-    """What a node process may reach: the clock, the codec, its buses and the physics."""
+class _Intact:
+    """Whether a frame passes the codec's size and CRC checks, computed once per frame on the wire:
+    the bus hands the same bytes object to every station in turn."""
 
-    def __init__(self, sim: "Simulation"):
-        self.sim = sim
-        self.sched = sim.sched
-        self.spec = sim.spec
-        self.codec = sim.codec
-        self.buses = sim.buses
-        self.params = sim.params
-        self.robot = sim.robot
-        self.sensors = sim.sensors
-        self.scenario = sim.scenario
-        self._cache: dict[bytes, Decoded | None] = {}
+    __slots__ = ("last", "ok")
 
-    def decode(self, data: bytes) -> Decoded | None:
-        c = self._cache
-        if data in c:
-            return c[data]
-        if len(c) > 20000:
-            c.clear()
-        d = c[data] = self.codec.decode(data)
-        return d
+    def __init__(self) -> None:
+        self.last: bytes | None = None
+        self.ok = False
 
-    def _slot(self, bus: str) -> float:
-        b = self.buses[bus]
-        return b.frame_time(self.spec.frame.overhead) + b.turnaround
+    def __call__(self, data: bytes) -> bool:
+        if data is not self.last:
+            self.last = data
+            try:
+                check(data)
+                self.ok = True
+            except CodecError:
+                self.ok = False
+        return self.ok
 
-    def backoff(self, bus: str, address: int) -> float:
-        """Spec arbitration address_backoff: (rank + 1) slots, rank by ascending address."""
-        slaves = sorted(n.address for n in self.spec.slaves(bus))
-        rank = slaves.index(address) if address in slaves else len(slaves)
-        return (rank + 1) * self._slot(bus)
 
-    def master_gap(self, bus: str) -> float:
-        """A master starts a new transaction one request slot after the line went idle."""
-        return self._slot(bus)
+_INTACT = _Intact()
 
-    def master_of(self, bus: str) -> str:
-        return self.spec.buses[bus].master
 
-    def record_post(self, short: str, missing: list[int]) -> None:
-        self.sim.post_reports[short] = (self.sched.now, missing)
+def _receiver(node: Runtime, hw: NodeHardware, intact: _Intact = _INTACT) -> Any:
+    """The node's UART: every frame on the bus reaches the skeleton's receive(), which parses it.
 
-    def set_verdict(self, v: Verdict) -> None:
-        self.sim.verdict = v
-        self.sim.verdict_time = self.sched.now
+    Shortcut, same outcome: a frame that is intact and addressed to another node
+    is dropped here instead of inside receive() (which ignores it silently).
+    """
+    own = node.address
+    receive = node.receive
 
-    def move_received(self, t: float, mov_cmd: int) -> None:
-        self.sim.moves.append((t, mov_cmd))
+    def deliver(bus: str, t: float, data: bytes) -> None:
+        if not hw.alive:
+            return
+        if data and data[0] != own and data[0] != BROADCAST and intact(data):
+            return
+        receive(bus, data)              # ours, broadcast, or bad: the skeleton parses (and reports) it
+    return deliver
 
-    def stimulus(self, t: float, kind: str = "") -> None:
-        self.sim.stimuli.append((t, kind))
 
-    def escaping(self, start: float, end: float) -> None:
-        self.sim.escapes.append((start, end))
-
-    def event(self, kind: str, t: float, leg: int) -> None:
-        self.sim.events.append((t, kind, leg))
+def _echo(node: Runtime, hw: NodeHardware) -> Any:
+    def echo(bus: str, t: float, sent: bytes, heard: bytes) -> None:
+        if hw.alive:
+            node.on_echo(bus, sent, heard)
+    return echo
 
 
 class Simulation:
     def __init__(self, scenario: Scenario, spec: Any, params: RobotParams = DEFAULT, keep_frames_every: float | None = None):
         self.scenario, self.spec, self.params = scenario, spec, params
         self.sched = Scheduler()
-        encodings.use_spec(spec)
-        self.codec = Codec(spec)
         self.world = World(scenario)
         self.robot = Robot(params, self.world, scenario.start)
         self.sensors = Sensors(self.world, self.robot, scenario.seed)
@@ -123,8 +118,9 @@ class Simulation:
         for name, b in spec.buses.items():
             self.buses[name] = Bus(name, self.sched, b.baud, b.bits_per_char, b.turnaround_us * 1e-6,
                                    stream(scenario.seed, f"bus:{name}"), self._trace)
-        self.ctx = Context(self)
-        self.nodes: dict[str, NodeProcess] = {}
+        self.config = Config(NetConfig.from_spec(spec), geometry=params, task=scenario.task)
+        self.nodes: dict[str, Runtime] = {}
+        self.hardware: dict[str, NodeHardware] = {}
         self.verdict: Verdict | None = None
         self.verdict_time: float | None = None
         self.post_reports: dict[str, tuple[float, list[int]]] = {}
@@ -146,20 +142,37 @@ class Simulation:
         for n in spec.nodes:
             if n.short in absent:
                 continue
-            proc = behaviour(n.role)(n, self.ctx)
-            self.nodes[n.short] = proc
+            hw = NodeHardware(self, n)
+            proc = behaviour_class(n.role)(n.address, hw.transmit, hw, self.config)
+            self.nodes[n.short], self.hardware[n.short] = proc, hw
             for bus in (n.bus, n.masters):
                 if bus is not None:
-                    proc.attach(bus, self.buses[bus].attach(n.short, proc.on_bytes, proc.on_echo))
+                    hw.ports[bus] = self.buses[bus].attach(n.short, _receiver(proc, hw), _echo(proc, hw))
         # a JAC that is absent, or whose LCP is, never gets a set-point: its servo is limp (CHOICE)
         for n in spec.role_nodes("JAC"):
             lcp = next(m for m in spec.role_nodes("LCP") if m.leg == n.leg)
             if n.short in absent or lcp.short in absent:
                 self.robot.legs[n.leg].joints[n.joint - 1].powered = False
 
-    # --- trace ------------------------------------------------------------------
+    # --- trace and telemetry ------------------------------------------------------
     def _trace(self, e: TraceEntry) -> None:
         self.frames.append(e)      # decoded only when written: the bytes determine the text
+
+    def on_note(self, node: Any, event: str, data: dict[str, Any]) -> None:
+        """A node's debug-port telemetry (behaviours.hardware.Hardware.note) into the metrics."""
+        t = self.sched.now
+        if event == "post_verdict":
+            self.verdict, self.verdict_time = data["verdict"], t
+        elif event == "post_report":
+            self.post_reports[node.short] = (t, list(data["missing"]))
+        elif event == "move":
+            self.moves.append((t, data["mov_cmd"]))
+        elif event == "stimulus":
+            self.stimuli.append((t, data.get("kind", "")))
+        elif event == "escape":
+            self.escapes.append((data["start"], data["end"]))
+        elif event in ("pit", "blocked"):
+            self.events.append((t, event, data.get("leg", 0)))
 
     # --- faults --------------------------------------------------------------------
     def _schedule_faults(self) -> None:
@@ -180,15 +193,18 @@ class Simulation:
         self.buses[bus].fault = fault
 
     def _kill(self, short: str) -> None:
-        proc = self.nodes[short]
-        proc.kill()
-        for port in proc.ports.values():
+        hw = self.hardware[short]
+        hw.alive = False
+        for port in hw.ports.values():
             port.killed = True
             port.queue.clear()
+        if hw.joint is not None:
+            # a dead JAC sends no more pulses: the hobby servo goes limp (CHOICE)
+            self.robot.legs[hw.leg].joints[hw.joint - 1].powered = False
         self.events.append((self.sched.now, "kill", 0))
 
     def _mute(self, short: str, on: bool) -> None:
-        for port in self.nodes[short].ports.values():
+        for port in self.hardware[short].ports.values():
             port.muted = on
 
     # --- clock ------------------------------------------------------------------------
@@ -230,9 +246,7 @@ class Simulation:
         dur = self.scenario.duration
         self._schedule_faults()
         for proc in self.nodes.values():
-            proc.start()
-            if proc.tick_period:
-                self._every(proc.tick_period, lambda t, p=proc: p.tick(t) if p.alive else None)
+            proc.start()                    # power-on: behaviours start their own timers
         self._every(self.params.dt, self._physics)
         self._every(POSE_SAMPLE_S, self._sample)
         self._every(CLEARANCE_SAMPLE_S, self._clearance)
@@ -243,22 +257,23 @@ class Simulation:
                       self.sensors, self.world, self.robot, self.snapshots)
 
 
-def trace_lines(frames: list[TraceEntry], spec: Any, codec: Codec) -> list[str]:
-    """One tab-separated line per frame: start, end, bus, sender, src, dst, message, bytes, flags."""
-    def name(addr: int | None) -> str:
-        if addr is None:
-            return "?"
-        if addr == spec.broadcast:
-            return "ALL"
-        n = spec.node_at(addr)
-        return n.short if n else f"0x{addr:02X}"
+def trace_lines(frames: list[TraceEntry]) -> list[str]:
+    """One tab-separated line per frame: start, end, bus, sender, src, dst, message, bytes, flags.
+
+    The message column is what the generated codec parses from the bytes heard
+    (arachnae_proto.frame.parse, Message.describe()); a frame it rejects shows
+    the codec's reason.
+    """
     out = []
     for f in frames:
         data = f.heard if f.heard is not None else f.sent
-        d = codec.decode(data)
-        msg = codec.describe(data) if d is not None else "<undecodable>"
-        out.append(f"{f.start:.6f}\t{f.end:.6f}\t{f.bus}\t{f.sender}\t{name(d.src if d else None)}\t"
-                   f"{name(d.dst if d else None)}\t{msg}\t{data.hex()}\t{','.join(f.flags)}")
+        try:
+            fr = parse(data)
+            src, dst, msg = name_of(fr.src), name_of(fr.dst), fr.message.describe()
+        except CodecError as err:
+            src = dst = "?"
+            msg = f"<{err.kind.name}: {err}>"
+        out.append(f"{f.start:.6f}\t{f.end:.6f}\t{f.bus}\t{f.sender}\t{src}\t{dst}\t{msg}\t{data.hex()}\t{','.join(f.flags)}")
     return out
 
 

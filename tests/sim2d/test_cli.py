@@ -55,3 +55,25 @@ def test_batch_runs_scenarios_times_seeds(tmp_path, write):
     assert sorted(d.name for d in (tmp_path / "runs").iterdir()) == ["a-seed1", "a-seed2", "b-seed1", "b-seed2"]
     p = cli("batch", str(a), "--seeds", "x")
     assert p.returncode == 1 and p.stderr.startswith("--seeds:")
+
+
+def test_same_seed_prints_the_same_hash_and_metrics_cover_issue_4(tmp_path):
+    from arachnae_proto.frame import parse
+
+    runs = [cli("run", str(ROOT / "scenarios" / "frame_loss.yaml"), "--seed", "4", "--out", str(tmp_path / d))
+            for d in ("a", "b")]
+    hashes = [next(ln for ln in p.stdout.splitlines() if ln.startswith("trace hash")) for p in runs]
+    assert runs[0].returncode == 0 and hashes[0] == hashes[1] and len(hashes[0]) == len("trace hash ") + 64
+    assert (tmp_path / "a" / "trace.tsv").read_bytes() == (tmp_path / "b" / "trace.tsv").read_bytes()
+    m = json.loads((tmp_path / "a" / "metrics.json").read_text())
+    for key in ("post", "distance_walked_m", "collisions", "min_clearance_m", "pit_events", "tilt_events",
+                "bus_layers", "frame_loss", "reaction_latencies_s", "trace_hash"):
+        assert key in m, key
+    assert m["post"]["verdict"] == "OPERATIONAL" and m["frame_loss"] > 0
+    assert set(m["bus_layers"]) == {"0", "1", "2"} and m["bus_layers"]["2"]["buses"] == [f"joints{i}" for i in range(1, 7)]
+    assert 0 < m["bus_layers"]["1"]["load_max"] < 1
+    # the trace's message column is the generated codec's reading of its bytes column
+    for line in (tmp_path / "a" / "trace.tsv").read_text().splitlines()[1:]:
+        cols = line.split("\t")
+        if not cols[6].startswith("<"):
+            assert parse(bytes.fromhex(cols[7])).message.describe() == cols[6]

@@ -5,9 +5,9 @@ import math
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from sim2d.gait import FORWARD, TURN_LEFT, Gait
+from behaviours.gait import FORWARD, TURN_LEFT, Gait
+from behaviours.kinematics import fk, ik
 from sim2d.geometry import rigid_fit, to_world
-from sim2d.kinematics import fk, ik
 from sim2d.robot import Robot
 from sim2d.robot_params import DEFAULT as P
 from sim2d.scenario import load_scenario

@@ -1,0 +1,87 @@
+"""Spec rules the behaviours need that the generated package does not carry yet.
+
+Wire facts (addresses, routes, bus baud rates and timeouts, message classes)
+come from the generated `arachnae_proto`. The `protocol`, `arbitration` and
+`post` sections of spec/nodes.yaml and each node's leg/joint are not in it
+(yet), so the host builds this object from the loaded spec and hands it to
+every behaviour; behaviours never import the spec loader, and never import
+the simulator (firmware logic, issue 5).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import arachnae_proto
+
+# What behaviours.runtime implements of the spec's arbitration rules; anything else is refused.
+_BACKOFF_SLOT = "request_frame"
+_BACKOFF_ORDER = "ascending_address"
+_TIMEOUT_TO = ("first_byte", "last_byte")
+
+
+@dataclass(frozen=True)
+class Protocol:
+    """nodes.yaml `protocol` (seed 3.2.2, origin: extension), times in seconds."""
+
+    response_timeout_to: str       # 'first_byte': a reply that has STARTED by the timeout is waited for
+    master_defer_slots: int        # request slots a master leaves free on an idle line before it sends
+    post_report_timeout_s: float   # how long a master waits for a sub-master's POST_REPORT (6.3)
+    move_retries: int              # MOVE_RELAYED resends until STATUS_ACK_MMC confirms it
+    setpoint_refresh_s: float      # unchanged LEG_TARGET / JOINT_TARGET repeated this often
+
+
+@dataclass(frozen=True)
+class Quorum:
+    """seed 6.3: at least `min_complete` units (nodes sharing `unit_key`) with every member present."""
+
+    name: str
+    unit_key: str
+    unit_roles: tuple[str, ...]
+    min_complete: int
+
+
+@dataclass(frozen=True)
+class NetConfig:
+    protocol: Protocol
+    arbitration: dict[str, str]            # bus -> 'address_backoff' | 'polled' | 'seed'
+    inactive_statuses: tuple[str, ...]     # seed 6.3: a node reporting one of these counts as missing
+    quorums: tuple[Quorum, ...]
+    units: dict[int, dict[str, int]]       # address -> {'leg': n, 'joint': m} where the spec gives them
+
+    def leg_of(self, address: int) -> int | None:
+        return self.units.get(address, {}).get("leg")
+
+    def joint_of(self, address: int) -> int | None:
+        return self.units.get(address, {}).get("joint")
+
+    @classmethod
+    def from_spec(cls, spec: Any) -> "NetConfig":
+        """From a loaded codegen.model.Spec (duck-typed); it must be the spec arachnae_proto was generated from."""
+        if spec.hash != arachnae_proto.SPEC_HASH:
+            raise ValueError(f"spec {spec.hash[:12]} is not the one arachnae_proto was generated from "
+                             f"({arachnae_proto.SPEC_HASH[:12]}); run `arachnae codegen`")
+        p = spec.protocol
+        if p.response_timeout_to not in _TIMEOUT_TO:
+            raise ValueError(f"protocol.response_timeout_to {p.response_timeout_to!r} is not one of {_TIMEOUT_TO}")
+        backoff = spec.arbitration.get("address_backoff", {})
+        if backoff and (backoff.get("slot"), backoff.get("rank_order")) != (_BACKOFF_SLOT, _BACKOFF_ORDER):
+            raise ValueError(f"arbitration.address_backoff: only slot {_BACKOFF_SLOT} ordered by {_BACKOFF_ORDER} is implemented")
+        return cls(
+            protocol=Protocol(p.response_timeout_to, int(p.master_defer_slots), p.post_report_timeout_ms / 1000,
+                              int(p.move_retries), p.setpoint_refresh_ms / 1000),
+            arbitration={name: b.arbitration for name, b in spec.buses.items()},
+            inactive_statuses=tuple(spec.post.inactive_statuses),
+            quorums=tuple(Quorum(q.name, q.unit_key, tuple(q.unit_roles), int(q.min_complete)) for q in spec.post.quorums),
+            units={n.address: {k: v for k, v in (("leg", n.leg), ("joint", n.joint)) if v is not None}
+                   for n in spec.nodes if n.leg is not None or n.joint is not None},
+        )
+
+
+@dataclass(frozen=True)
+class Config:
+    """Everything a behaviour is configured with: the network rules, the robot's geometry, the mission."""
+
+    net: NetConfig
+    geometry: Any                  # behaviours.geometry.RobotGeometry (or a subclass)
+    task: str = "forward"          # NP3 task (SPEC-NOTES decision 8): forward, explore, seek_light, ...

@@ -1,0 +1,126 @@
+"""POST (seed 6.3, SPEC-NOTES decisions 2 and 3): each master identifies its own
+slaves with ID_REQ (bus response timeout, id_retries), asks each for its
+status, then asks its sub-masters for their POST_REPORT; the MCP turns the
+missing nodes into the verdict by the spec's declared rules.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+from arachnae_proto import messages as M
+from arachnae_proto.network import NODES
+
+from behaviours.netconfig import NetConfig
+from behaviours.runtime import slaves_of
+
+_STATUS_REPLIES = (M.StatusAckOrder, M.StatusAckRange, M.StatusAckMmc)
+
+
+@dataclass(frozen=True)
+class Verdict:
+    verdict: str                  # OPERATIONAL | DEGRADED | HALTED
+    missing: tuple[str, ...]      # short names
+    reasons: tuple[str, ...]
+
+
+def behind(address: int) -> list[int]:
+    """Every node reached only through `address` (decision 2): its bus's slaves, recursively."""
+    bus = NODES[address][3]
+    out: list[int] = []
+    if bus is not None:
+        for a in slaves_of(bus):
+            out += [a] + behind(a)
+    return out
+
+
+def verdict(net: NetConfig, missing_addresses: list[int]) -> Verdict:
+    """HALTED when a required node outside every quorum or a quorum's minimum is lost,
+    DEGRADED when an optional node or a quorum member is lost, else OPERATIONAL."""
+    missing = {a for a in missing_addresses if a in NODES}
+    halted: list[str] = []
+    degraded: list[str] = []
+    in_quorum: set[int] = set()
+    for q in net.quorums:
+        units: dict[int, list[int]] = {}
+        for a, (_short, role, *_rest) in NODES.items():
+            key = net.units.get(a, {}).get(q.unit_key)
+            if role in q.unit_roles and key is not None:
+                units.setdefault(key, []).append(a)
+                in_quorum.add(a)
+        complete = [k for k, members in units.items() if not missing.intersection(members)]
+        if len(complete) < q.min_complete:
+            halted.append(f"{q.name}: {len(complete)} of {len(units)} complete, at least {q.min_complete} needed")
+        elif len(complete) < len(units):
+            lost = sorted(set(units) - set(complete))
+            degraded.append(f"{q.name}: {', '.join(str(k) for k in lost)} incomplete")
+    for a, (short, _role, _bus, _masters, required) in NODES.items():
+        if a in missing and a not in in_quorum:
+            (halted if required else degraded).append(f"{short} missing ({'required' if required else 'optional'})")
+    names = tuple(sorted(NODES[a][0] for a in missing))
+    if halted:
+        return Verdict("HALTED", names, tuple(halted))
+    if degraded:
+        return Verdict("DEGRADED", names, tuple(degraded))
+    return Verdict("OPERATIONAL", (), ())
+
+
+class PostMaster:
+    """Mixin (before Runtime) for every bus master: runs POST on its bus and answers POST_QUERY."""
+
+    post_missing: list[int] | None = None      # None until this master's POST has finished
+
+    def run_post(self, done: Callable[[list[int]], None] | None = None) -> None:
+        self.post_missing = None
+        self._post_waiting: list[int] = getattr(self, "_post_waiting", [])
+        missing: list[int] = []
+        retries = self.links[self.master_bus].timing.id_retries          # type: ignore[attr-defined]
+        inactive = set()
+        for cls in (M.StatusAckOrder, M.StatusAckRange):
+            enum = cls.FIELDS[0].enum
+            inactive |= {(cls, int(enum[s])) for s in self.net.inactive_statuses if s in enum.__members__}  # type: ignore[attr-defined]
+
+        def lost(a: int) -> None:
+            missing.append(a)
+            missing.extend(behind(a))
+
+        for a in slaves_of(self.master_bus):                              # type: ignore[attr-defined]
+            def on_status(src: int, msg: M.Message, a: int = a) -> None:
+                if (type(msg), getattr(msg, "status", None)) in inactive:
+                    lost(a)                                                # seed 6.3: declares itself inactive
+
+            def on_ack(src: int, msg: M.Message, a: int = a) -> None:
+                if NODES[a][1] in M.StatusAckBusy.SENDERS:
+                    return                                                 # busy / free is no health status
+                self.request(a, M.StatusReq(), _STATUS_REPLIES, on_status, lambda a=a: lost(a), retries)  # type: ignore[attr-defined]
+            self.request(a, M.IdReq(), (M.IdAck,), on_ack, lambda a=a: lost(a), retries)  # type: ignore[attr-defined]
+
+        def finish() -> None:
+            self.post_missing = sorted(set(missing))
+            self.hw.note("post_report", node=self.name, missing=self.post_missing)  # type: ignore[attr-defined]
+            for src in self._post_waiting:
+                self._post_report(src)
+            self._post_waiting.clear()
+            if done is not None:
+                done(self.post_missing)
+
+        def query_subs() -> None:
+            def on_report(src: int, msg: M.PostReport) -> None:
+                missing.extend(msg.missing)
+            for a in slaves_of(self.master_bus):                          # type: ignore[attr-defined]
+                if NODES[a][3] is not None and a not in missing:
+                    self.request(a, M.PostQuery(), (M.PostReport,), on_report, lambda a=a: lost(a), retries,  # type: ignore[attr-defined]
+                                 self.net.protocol.post_report_timeout_s)  # type: ignore[attr-defined]
+            self.when_idle(finish)                                         # type: ignore[attr-defined]
+
+        self.when_idle(query_subs)                                         # type: ignore[attr-defined]
+
+    def on_post_query(self, src: int, msg: M.PostQuery) -> None:
+        """seed 6.3: report when this master's own POST is done."""
+        if self.post_missing is None:
+            self.__dict__.setdefault("_post_waiting", []).append(src)
+        else:
+            self._post_report(src)
+
+    def _post_report(self, src: int) -> None:
+        self.send(src, M.PostReport(missing=self.post_missing or []))     # type: ignore[attr-defined]

@@ -1,0 +1,246 @@
+"""What every node's firmware shares beyond the generated skeleton: timers,
+master transactions and slave-initiated frames (seed 3.2.2).
+
+`Runtime` is a mixin placed before the generated skeleton in a behaviour's
+bases (`class MMC(Runtime, MmcSkeleton)`): the skeleton frames, routes and
+dispatches; this adds
+  - `every(period, fn)`: a periodic timer on the board's clock;
+  - `request(...)`: a master's transaction on the bus it masters, one at a
+    time in order: the frame goes out after `master_defer_slots` request slots
+    (so slaves' XMIT_REQ / DATA_RDY get the line), is resent after a corrupt
+    echo, and a reply not begun within the bus's response timeout is retried
+    `id_retries` times (seed 3.2.2: 10 ms, one retry);
+  - `slave_send(...)`: a slave-initiated frame, started only on a line idle
+    for longer than the turnaround, resent after a corrupt echo following the
+    bus's arbitration rule (address_backoff: rank + 1 slots).
+Bus timing comes from arachnae_proto.network.BUSES, protocol rules from the
+host-supplied NetConfig: nothing here is a number of its own.
+"""
+from __future__ import annotations
+
+from collections import deque
+from typing import Any, Callable
+
+from arachnae_proto.frame import OVERHEAD, Frame, build
+from arachnae_proto.messages import Message
+from arachnae_proto.network import BUSES, NODES
+
+from behaviours.hardware import Hardware
+from behaviours.netconfig import Config
+
+Reply = Callable[[int, Message], None]
+
+
+class BusTiming:
+    """One bus's timing from the spec (nodes.yaml `buses`, via arachnae_proto)."""
+
+    __slots__ = ("char_s", "turnaround_s", "slot_s", "timeout_s", "id_retries")
+
+    def __init__(self, bus: str) -> None:
+        _master, baud, bits, turnaround_us, _gap, timeout_ms, retries = BUSES[bus]
+        self.char_s = bits / baud
+        self.turnaround_s = turnaround_us * 1e-6
+        # spec arbitration: one slot = one request frame (no payload) plus turnaround
+        self.slot_s = OVERHEAD * self.char_s + self.turnaround_s
+        self.timeout_s = timeout_ms / 1000
+        self.id_retries = retries
+
+
+def slaves_of(bus: str) -> list[int]:
+    """Addresses of the nodes sitting on `bus` as slaves, ascending."""
+    return sorted(a for a, (_n, _r, on, _m, _req) in NODES.items() if on == bus)
+
+
+class Request:
+    __slots__ = ("dst", "msg", "expect", "on_reply", "on_timeout", "retries", "timeout", "serial")
+
+    def __init__(self, dst: int, msg: Message, expect: tuple, on_reply: Reply | None,
+                 on_timeout: Callable[[], None] | None, retries: int, timeout: float) -> None:
+        self.dst, self.msg, self.expect, self.on_reply = dst, msg, expect, on_reply
+        self.on_timeout, self.retries, self.timeout, self.serial = on_timeout, retries, timeout, 0
+
+
+class MasterLink:
+    """A master's side of the bus it polls: one transaction at a time, in order."""
+
+    __slots__ = ("bus", "timing", "queue", "current", "serial", "frame", "waiters")
+
+    def __init__(self, bus: str) -> None:
+        self.bus, self.timing = bus, BusTiming(bus)
+        self.queue: deque[Request] = deque()
+        self.current: Request | None = None
+        self.serial = 0
+        self.frame = b""
+        self.waiters: deque[Callable[[], Any]] = deque()
+
+
+class Runtime:
+    """Mixin for a generated skeleton: constructor (address, transmit, hw, cfg)."""
+
+    def __init__(self, address: int, transmit: Callable[[str, bytes], None], hw: Hardware, cfg: Config) -> None:
+        super().__init__(address, transmit)  # type: ignore[call-arg]
+        self.hw, self.cfg, self.net = hw, cfg, cfg.net
+        self.master_bus: str | None = NODES[address][3]
+        self.links: dict[str, MasterLink] = {self.master_bus: MasterLink(self.master_bus)} if self.master_bus else {}
+        self._slave_out: dict[str, deque[bytes]] = {}
+        self._timings: dict[str, BusTiming] = {}
+
+    # --- life cycle and time ------------------------------------------------------------
+    def start(self) -> None:
+        """Power-on (t = 0). Behaviours start their timers and their POST here."""
+
+    @property
+    def now(self) -> float:
+        return self.hw.now()
+
+    def every(self, period: float, fn: Callable[[], Any]) -> None:
+        """Call fn now and every `period` seconds."""
+        after = self.hw.after
+
+        def run() -> None:
+            fn()
+            after(period, run)
+        after(0.0, run)
+
+    # --- master side ----------------------------------------------------------------------
+    def request(self, dst: int, msg: Message, expect: tuple = (), on_reply: Reply | None = None,
+                on_timeout: Callable[[], None] | None = None, retries: int | None = None,
+                timeout: float | None = None, urgent: bool = False) -> None:
+        """Queue a transaction on the bus this node masters. `expect`: reply classes; empty: done once sent."""
+        link = self.links[self.master_bus]  # type: ignore[index]
+        t = link.timing
+        req = Request(dst, msg, expect, on_reply, on_timeout, t.id_retries if retries is None else retries,
+                      t.timeout_s if timeout is None else timeout)
+        if urgent:
+            link.queue.appendleft(req)
+        else:
+            link.queue.append(req)
+        if link.current is None:
+            self._next(link)
+
+    def when_idle(self, fn: Callable[[], Any]) -> None:
+        """Run fn once every transaction queued so far on the mastered bus has finished."""
+        link = self.links[self.master_bus]  # type: ignore[index]
+        if link.current is None and not link.queue:
+            fn()
+        else:
+            link.waiters.append(fn)
+
+    def _next(self, link: MasterLink) -> None:
+        if link.current is not None:
+            return
+        if not link.queue:
+            while link.waiters and link.current is None and not link.queue:
+                link.waiters.popleft()()
+            return
+        link.serial += 1
+        req = link.queue.popleft()
+        req.serial = link.serial
+        link.current = req
+        # spec protocol.master_defer_slots: leave the line to slaves' requests for this many slots
+        self.hw.after(self.net.protocol.master_defer_slots * link.timing.slot_s, self._transmit, link, req.serial)
+
+    def _transmit(self, link: MasterLink, serial: int) -> None:
+        req = link.current
+        if req is None or req.serial != serial:
+            return
+        link.frame = self.send(req.dst, req.msg)  # type: ignore[attr-defined]
+
+    def _timeout(self, link: MasterLink, serial: int) -> None:
+        req = link.current
+        if req is None or req.serial != serial:
+            return
+        # spec protocol.response_timeout_to = first_byte: a reply already on the line is waited for
+        if self.net.protocol.response_timeout_to == "first_byte" and self.hw.line_idle_s(link.bus) == 0.0:
+            self.hw.after(link.timing.char_s, self._timeout, link, serial)
+            return
+        if req.retries > 0:
+            req.retries -= 1
+            self._transmit(link, serial)
+            return
+        link.current = None
+        if req.on_timeout is not None:
+            req.on_timeout()
+        self._next(link)
+
+    def dispatch(self, frame: Frame) -> None:
+        """A reply the current transaction waits for completes it; everything else goes to the on_ hooks."""
+        bus = self.routes.get(frame.src)  # type: ignore[attr-defined]
+        link = self.links.get(bus) if bus is not None else None
+        if link is not None:
+            req = link.current
+            if req is not None and frame.src == req.dst and type(frame.message) in req.expect:
+                link.current = None
+                if req.on_reply is not None:
+                    req.on_reply(frame.src, frame.message)
+                self._next(link)
+                return
+        super().dispatch(frame)  # type: ignore[misc]
+
+    # --- echo: the transceiver reads back every frame this node sends (seed 3.2.2) --------------
+    def on_echo(self, bus: str, sent: bytes, heard: bytes) -> None:
+        link = self.links.get(bus)
+        if link is not None and link.current is not None and sent == link.frame:
+            req, serial = link.current, link.current.serial
+            if heard != sent:                      # seed 3.2.2: corrupt echo -> send again
+                self.hw.after(link.timing.turnaround_s, self._transmit, link, serial)
+            elif not req.expect:
+                link.current = None
+                self._next(link)
+            else:
+                self.hw.after(req.timeout, self._timeout, link, serial)
+            return
+        self._slave_echo(bus, sent, heard)
+
+    # --- slave side -------------------------------------------------------------------------
+    def slave_send(self, dst: int, msg: Message) -> None:
+        """A frame the slave starts on its own (XMIT_REQ, DATA_RDY): resent until its echo is clean."""
+        bus = self.routes[dst]  # type: ignore[attr-defined]
+        if self.net.arbitration.get(bus) == "polled":
+            raise ValueError(f"bus {bus} is polled: slaves never start a frame (spec arbitration)")
+        if type(msg) not in self.SENDS:  # type: ignore[attr-defined]
+            raise ValueError(f"{self.ROLE} does not send {msg.NAME} (spec)")  # type: ignore[attr-defined]
+        q = self._slave_out.setdefault(bus, deque())
+        q.append(build(dst, self.address, msg))  # type: ignore[attr-defined]
+        if len(q) == 1:
+            self._slave_start(bus)
+
+    def _slave_start(self, bus: str) -> None:
+        """seed 3.2.2: send 'when the bus is idle'. Read as: idle for longer than the turnaround, because
+        right after a master's frame the line is idle only until the polled slave's reply starts; a
+        request started there would hit that reply, and again after every backoff (lockstep)."""
+        q = self._slave_out.get(bus)
+        if not q:
+            return
+        t = self._timing(bus)
+        idle = self.hw.line_idle_s(bus)
+        if idle <= t.turnaround_s:
+            self.hw.after(t.turnaround_s - idle + t.char_s if idle > 0 else t.char_s, self._slave_start, bus)
+            return
+        self.transmit(bus, q[0])  # type: ignore[attr-defined]
+
+    def _slave_echo(self, bus: str, sent: bytes, heard: bytes) -> None:
+        q = self._slave_out.get(bus)
+        if not q or sent != q[0]:
+            return
+        if heard == sent:
+            q.popleft()
+            if q:
+                self._slave_start(bus)
+        else:
+            self.hw.after(self._backoff(bus), self._slave_start, bus)
+
+    def _timing(self, bus: str) -> BusTiming:
+        t = self._timings.get(bus)
+        if t is None:
+            t = self._timings[bus] = BusTiming(bus)
+        return t
+
+    def _backoff(self, bus: str) -> float:
+        """seed 3.2.2 resends at once; spec address_backoff waits (rank + 1) slots, rank by ascending address."""
+        t = self._timing(bus)
+        if self.net.arbitration.get(bus) != "address_backoff":
+            return t.turnaround_s
+        slaves = slaves_of(bus)
+        rank = slaves.index(self.address) if self.address in slaves else len(slaves)  # type: ignore[attr-defined]
+        return (rank + 1) * t.slot_s

@@ -1,0 +1,382 @@
+"""The NP3's topological map (seed 3.3.2: "Generieren, modifizieren und adaptieren einer Topologischen Map").
+
+Why two layers: the ultrasonic head (seed 3.2.11: 0..10 m, 1 deg steps, a
+full scan within 8 s) gives ranges, which an occupancy grid turns into free
+and occupied space; navigation (5.2: 10..30 s per plan) wants few places and
+passable connections, which the graph on top of the grid gives:
+
+  - places: in every `place_spacing_m` block of the grid, the free cell
+    farthest from any obstacle or unknown cell (a point on the free space's
+    medial axis, Voronoi-like), if that clearance is at least the robot's
+    radius;
+  - edges: between places in neighbouring blocks when the straight line
+    between them keeps the robot's clearance all the way (never through a
+    wall, never through unknown space).
+
+The map is rebuilt ("modified and adapted") from the grid after each scan;
+`coverage()` says how much of a declared room polygon has been seen,
+`frontier()` picks the next place to explore (the nearest reachable cluster
+of free cells bordering unknown space), `save_png()` draws it all. Pure
+Python (no numpy): a 10 m x 10 m room at 10 cm is 10^4 cells.
+"""
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterable, Sequence
+
+UNKNOWN, FREE, OCCUPIED = 0, 1, 2
+
+USRC_MAX_RANGE_M = 10.0      # seed 3.2.11: 0..255 = 0..10 m
+USRC_MIN_RANGE_M = 0.3       # seed 5.2: the scanner is used from 30 cm to about 10 m
+
+
+@dataclass(frozen=True)
+class Reading:
+    """One ultrasonic reading: robot pose, head angle relative to the body, range (None: no echo)."""
+
+    x: float              # m, world frame
+    y: float              # m
+    heading_deg: float    # robot heading, counter-clockwise from +x
+    head_deg: float       # USRC head angle relative to the body (seed 3.2.11), counter-clockwise
+    distance_m: float | None
+
+    @property
+    def bearing(self) -> float:
+        return math.radians(self.heading_deg + self.head_deg)
+
+
+@dataclass(frozen=True)
+class Place:
+    id: int
+    x: float
+    y: float
+    clearance_m: float
+    block: tuple[int, int]  # which place_spacing_m block of the grid it stands for
+
+
+@dataclass(frozen=True)
+class Frontier:
+    x: float
+    y: float
+    size: int             # cells in the cluster
+    path_m: float         # length of the free path from the robot
+
+
+class OccupancyGrid:
+    """Log-odds occupancy grid over a rectangle; a cell is FREE, OCCUPIED or UNKNOWN."""
+
+    def __init__(self, x0: float, y0: float, width_m: float, height_m: float, resolution_m: float = 0.1) -> None:
+        self.x0, self.y0, self.res = x0, y0, resolution_m
+        self.nx = max(1, int(math.ceil(width_m / resolution_m)))
+        self.ny = max(1, int(math.ceil(height_m / resolution_m)))
+        self.logodds = [0.0] * (self.nx * self.ny)
+        self.seen = bytearray(self.nx * self.ny)       # ever crossed by a beam: coverage only grows
+        self.hit, self.miss, self.limit = 0.9, -0.4, 5.0
+
+    # -- coordinates ----------------------------------------------------------------
+    def cell(self, x: float, y: float) -> tuple[int, int]:
+        return int(math.floor((x - self.x0) / self.res)), int(math.floor((y - self.y0) / self.res))
+
+    def centre(self, i: int, j: int) -> tuple[float, float]:
+        return self.x0 + (i + 0.5) * self.res, self.y0 + (j + 0.5) * self.res
+
+    def inside(self, i: int, j: int) -> bool:
+        return 0 <= i < self.nx and 0 <= j < self.ny
+
+    def state(self, i: int, j: int) -> int:
+        if not self.inside(i, j):
+            return UNKNOWN
+        v = self.logodds[j * self.nx + i]
+        return OCCUPIED if v > 0.5 else FREE if v < -0.3 else UNKNOWN
+
+    def state_at(self, x: float, y: float) -> int:
+        return self.state(*self.cell(x, y))
+
+    # -- updates --------------------------------------------------------------------
+    def _bump(self, i: int, j: int, delta: float) -> None:
+        k = j * self.nx + i
+        self.logodds[k] = max(-self.limit, min(self.limit, self.logodds[k] + delta))
+        self.seen[k] = 1
+
+    def integrate(self, r: Reading, max_range_m: float = USRC_MAX_RANGE_M) -> None:
+        """Free cells along the beam, an occupied cell at the echo (none without an echo).
+
+        Echoes nearer than 30 cm are dropped: the scanner is not used there (seed 5.2).
+        """
+        if r.distance_m is not None and r.distance_m < USRC_MIN_RANGE_M:
+            return
+        echo = r.distance_m is not None and r.distance_m < max_range_m
+        length = r.distance_m if echo else max_range_m
+        # the echo's surface may lie on a cell border: free what the beam crossed in front of it,
+        # mark occupied the cell just behind it (a quarter cell either side)
+        hit = None
+        if echo:
+            hit = self.cell(r.x + (length + self.res / 4) * math.cos(r.bearing),
+                            r.y + (length + self.res / 4) * math.sin(r.bearing))
+        for c in ray_cells(r.x, r.y, r.bearing, length - self.res / 4 if echo else length, self.res, self.x0, self.y0):
+            if c != hit and self.inside(*c):
+                self._bump(*c, self.miss)
+        if hit is not None and self.inside(*hit):
+            self._bump(*hit, self.hit)
+
+
+def ray_cells(x: float, y: float, angle: float, length: float, res: float, x0: float = 0.0,
+              y0: float = 0.0) -> Iterable[tuple[int, int]]:
+    """Every grid cell the ray from (x, y) crosses within `length` (Amanatides-Woo traversal)."""
+    dx, dy = math.cos(angle), math.sin(angle)
+    gx, gy = (x - x0) / res, (y - y0) / res
+    i, j = int(math.floor(gx)), int(math.floor(gy))
+    step_i, step_j = (1 if dx > 0 else -1), (1 if dy > 0 else -1)
+    t_max_i = ((i + (dx > 0)) - gx) * res / dx if dx else math.inf
+    t_max_j = ((j + (dy > 0)) - gy) * res / dy if dy else math.inf
+    t_delta_i = res / abs(dx) if dx else math.inf
+    t_delta_j = res / abs(dy) if dy else math.inf
+    while True:
+        yield i, j
+        if min(t_max_i, t_max_j) > length:
+            return
+        if t_max_i < t_max_j:
+            i += step_i
+            t_max_i += t_delta_i
+        else:
+            j += step_j
+            t_max_j += t_delta_j
+
+
+def line_cells(a: tuple[int, int], b: tuple[int, int]) -> Iterable[tuple[int, int]]:
+    """Bresenham: the grid cells on the segment a-b, a first, b last."""
+    (x, y), (x1, y1) = a, b
+    dx, dy = abs(x1 - x), -abs(y1 - y)
+    sx, sy = (1 if x1 > x else -1), (1 if y1 > y else -1)
+    err = dx + dy
+    while True:
+        yield x, y
+        if (x, y) == (x1, y1):
+            return
+        e2 = 2 * err
+        if e2 >= dy:
+            err += dy
+            x += sx
+        if e2 <= dx:
+            err += dx
+            y += sy
+
+
+def point_in_polygon(x: float, y: float, poly: Sequence[tuple[float, float]]) -> bool:
+    inside = False
+    n = len(poly)
+    for k in range(n):
+        (xa, ya), (xb, yb) = poly[k], poly[(k + 1) % n]
+        if (ya > y) != (yb > y) and x < xa + (y - ya) * (xb - xa) / (yb - ya):
+            inside = not inside
+    return inside
+
+
+_N8 = ((1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (1, -1), (-1, 1), (-1, -1))
+
+
+class TopoMap:
+    """Grid + places + edges + the robot's path, rebuilt from the grid after every scan."""
+
+    def __init__(self, grid: OccupancyGrid, robot_radius_m: float = 0.25, place_spacing_m: float = 1.0,
+                 room: Sequence[tuple[float, float]] | None = None) -> None:
+        self.grid = grid
+        self.robot_radius_m = robot_radius_m
+        self.place_spacing_m = place_spacing_m
+        self.room = list(room) if room else None
+        self.path: list[tuple[float, float]] = []
+        self.places: list[Place] = []
+        self.edges: set[tuple[int, int]] = set()
+        self.clearance: list[float] = []
+
+    # -- building -------------------------------------------------------------------
+    def add_scan(self, readings: Iterable[Reading]) -> None:
+        """Integrate one scan and adapt the graph to it."""
+        for r in readings:
+            if not self.path or self.path[-1] != (r.x, r.y):
+                self.path.append((r.x, r.y))
+            self.grid.integrate(r)
+        self.rebuild()
+
+    def rebuild(self) -> None:
+        self.clearance = self._clearance()
+        self.places = self._places()
+        self.edges = self._edges()
+
+    def _clearance(self) -> list[float]:
+        """Distance in m from each free cell to the nearest non-free cell (multi-source BFS, 8-connected)."""
+        g = self.grid
+        dist = [math.inf] * (g.nx * g.ny)
+        queue: deque[tuple[int, int]] = deque()
+        for j in range(g.ny):
+            for i in range(g.nx):
+                if g.state(i, j) != FREE:
+                    dist[j * g.nx + i] = 0.0
+                    queue.append((i, j))
+        while queue:
+            i, j = queue.popleft()
+            d = dist[j * g.nx + i]
+            for di, dj in _N8:
+                a, b = i + di, j + dj
+                if g.inside(a, b) and dist[b * g.nx + a] > d + 1:
+                    dist[b * g.nx + a] = d + 1
+                    queue.append((a, b))
+        for j in range(g.ny):                        # beyond the grid's border is unknown too
+            for i in range(g.nx):
+                dist[j * g.nx + i] = min(dist[j * g.nx + i], i + 1, j + 1, g.nx - i, g.ny - j)
+        return [d * g.res for d in dist]
+
+    def _places(self) -> list[Place]:
+        g, block = self.grid, max(1, int(round(self.place_spacing_m / self.grid.res)))
+        places: list[Place] = []
+        for bj in range(0, g.ny, block):
+            for bi in range(0, g.nx, block):
+                best, best_c = None, self.robot_radius_m
+                for j in range(bj, min(bj + block, g.ny)):
+                    for i in range(bi, min(bi + block, g.nx)):
+                        c = self.clearance[j * g.nx + i]
+                        if c >= best_c and (best is None or c > best_c):
+                            best, best_c = (i, j), c
+                if best is not None:
+                    x, y = g.centre(*best)
+                    places.append(Place(len(places), x, y, best_c, (bi // block, bj // block)))
+        return places
+
+    def passable(self, a: tuple[float, float], b: tuple[float, float]) -> bool:
+        """The robot's disc fits along the straight segment a-b (free cells with clearance >= radius)."""
+        g = self.grid
+        for i, j in line_cells(g.cell(*a), g.cell(*b)):
+            if not g.inside(i, j) or self.clearance[j * g.nx + i] < self.robot_radius_m:
+                return False
+        return True
+
+    def _edges(self) -> set[tuple[int, int]]:
+        """Places of 8-neighbouring blocks, where the robot fits along the straight line between them."""
+        edges = set()
+        for a in self.places:
+            for b in self.places:
+                near = max(abs(a.block[0] - b.block[0]), abs(a.block[1] - b.block[1])) == 1
+                if a.id < b.id and near and self.passable((a.x, a.y), (b.x, b.y)):
+                    edges.add((a.id, b.id))
+        return edges
+
+    # -- questions ------------------------------------------------------------------
+    def neighbours(self, place_id: int) -> set[int]:
+        return {b if a == place_id else a for a, b in self.edges if place_id in (a, b)}
+
+    def component(self, place_id: int) -> set[int]:
+        seen, todo = {place_id}, [place_id]
+        while todo:
+            for n in self.neighbours(todo.pop()):
+                if n not in seen:
+                    seen.add(n)
+                    todo.append(n)
+        return seen
+
+    def coverage(self) -> float:
+        """Share of the room polygon's cells that some beam has crossed or hit (0..1)."""
+        if not self.room:
+            raise ValueError("no room polygon declared")
+        g = self.grid
+        total = seen = 0
+        for j in range(g.ny):
+            for i in range(g.nx):
+                if point_in_polygon(*g.centre(i, j), self.room):
+                    total += 1
+                    seen += g.seen[j * g.nx + i]
+        return seen / total if total else 0.0
+
+    def frontier(self, x: float, y: float, min_size: int = 5) -> Frontier | None:
+        """The nearest (by free path) cluster of free cells bordering open unknown space; None when explored.
+
+        Clusters smaller than `min_size` cells are gaps between diverging beams, not frontiers.
+        """
+        g = self.grid
+        start = g.cell(x, y)
+        if not g.inside(*start):
+            return None
+        dist = {start: 0.0}
+        queue = deque([start])
+        while queue:                                 # reachable free cells, path length in m
+            i, j = queue.popleft()
+            for di, dj in _N8:
+                n = (i + di, j + dj)
+                if n not in dist and g.state(*n) == FREE:
+                    dist[n] = dist[(i, j)] + g.res * math.hypot(di, dj)
+                    queue.append(n)
+
+        def open_unknown(i: int, j: int) -> bool:
+            # an unknown cell next to an occupied one is most likely a wall cell a grazing beam missed
+            return g.inside(i, j) and g.state(i, j) == UNKNOWN and all(
+                g.state(i + di, j + dj) != OCCUPIED for di, dj in _N8)
+
+        def is_frontier(c: tuple[int, int]) -> bool:
+            return g.state(*c) == FREE and any(open_unknown(c[0] + di, c[1] + dj) for di, dj in _N8)
+
+        cells = {c for c in dist if is_frontier(c)}
+        best: Frontier | None = None
+        while cells:
+            seed = min(cells)
+            cluster, todo = [seed], [seed]
+            cells.discard(seed)
+            while todo:
+                i, j = todo.pop()
+                for di, dj in _N8:
+                    n = (i + di, j + dj)
+                    if n in cells:
+                        cells.discard(n)
+                        cluster.append(n)
+                        todo.append(n)
+            if len(cluster) < min_size:
+                continue
+            target = min(cluster, key=lambda c: (dist[c], c))
+            cand = Frontier(*g.centre(*target), size=len(cluster), path_m=dist[target])
+            if best is None or (cand.path_m, -cand.size) < (best.path_m, -best.size):
+                best = cand
+        return best
+
+    # -- picture --------------------------------------------------------------------
+    def save_png(self, path: str | Path, px_per_cell: int = 4) -> Path:
+        """Grid (unknown grey, free white, occupied black), room outline, edges, places, robot path."""
+        from PIL import Image, ImageDraw
+
+        g, s = self.grid, px_per_cell
+        img = Image.new("RGB", (g.nx * s, g.ny * s), (160, 160, 160))
+        draw = ImageDraw.Draw(img)
+        colour = {UNKNOWN: (160, 160, 160), FREE: (255, 255, 255), OCCUPIED: (0, 0, 0)}
+        for j in range(g.ny):
+            for i in range(g.nx):
+                st = g.state(i, j)
+                if st != UNKNOWN:
+                    top = (g.ny - 1 - j) * s
+                    draw.rectangle((i * s, top, i * s + s - 1, top + s - 1), fill=colour[st])
+
+        def px(x: float, y: float) -> tuple[float, float]:
+            return (x - g.x0) / g.res * s, (g.ny - (y - g.y0) / g.res) * s
+
+        if self.room:
+            draw.polygon([px(*p) for p in self.room], outline=(0, 160, 0))
+        by_id = {p.id: p for p in self.places}
+        for a, b in sorted(self.edges):
+            draw.line([px(by_id[a].x, by_id[a].y), px(by_id[b].x, by_id[b].y)], fill=(40, 90, 230), width=2)
+        for p in self.places:
+            (cx, cy), r = px(p.x, p.y), max(3, s)
+            draw.ellipse((cx - r, cy - r, cx + r, cy + r), fill=(220, 30, 30))
+        if len(self.path) > 1:
+            draw.line([px(*p) for p in self.path], fill=(230, 140, 0), width=2)
+        out = Path(path)
+        img.save(out, format="PNG")
+        return out
+
+
+def full_scan(x: float, y: float, heading_deg: float, ranges: Sequence[float | None],
+              step_deg: float = 1.0) -> list[Reading]:
+    """Readings of one USRC sweep (seed 3.2.11: 360 deg at 1 deg) from `ranges[k]` at head angle k*step."""
+    return [Reading(x, y, heading_deg, k * step_deg, d) for k, d in enumerate(ranges)]
+
+
+__all__ = ["Reading", "Place", "Frontier", "OccupancyGrid", "TopoMap", "full_scan", "line_cells", "ray_cells",
+           "point_in_polygon", "UNKNOWN", "FREE", "OCCUPIED", "USRC_MAX_RANGE_M", "USRC_MIN_RANGE_M"]

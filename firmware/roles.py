@@ -1,0 +1,176 @@
+"""Build configuration of the firmware, derived from the spec (used by firmware/Makefile).
+
+    python firmware/roles.py list                 roles, lower case, one a line
+    python firmware/roles.py msgs ROLE            the generated msg_*.c this role sends or receives
+    python firmware/roles.py config ROLE OUT.h    bus timing and addresses of ROLE as #defines
+    python firmware/roles.py stubs OUTDIR         empty behaviours for every role (size images, fuzzing)
+    python firmware/roles.py mk OUT.mk            ROLES and MSGS_<role> for make
+    python firmware/roles.py fuzzroles OUT.h      every role's check and dispatch, for fuzz/fuzz_frame.c
+
+The generated C has no per-bus timing constants (baud, turnaround, idle gap,
+backoff slot), so the firmware build derives them here from the same model the
+generator reads; nothing is typed in by hand.
+"""
+from __future__ import annotations
+
+import math
+import re
+import sys
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(REPO))
+GEN_C = REPO / "generated" / "c"
+
+
+def _spec():
+    from codegen.model import load_spec
+    return load_spec()
+
+
+def msg_file(name: str) -> str:
+    return f"msg_{name.lower()}.c"
+
+
+def role_msgs(spec, role: str) -> list[str]:
+    """The message files of every message the role sends or receives (decision 2: nothing else is linked)."""
+    names = {m.name for m in spec.sends(role)} | {m.name for m in spec.receives(role)}
+    return sorted(msg_file(n) for n in names)
+
+
+def find_role(spec, name: str) -> str:
+    for r in spec.roles:
+        if r.lower() == name.lower():
+            return r
+    raise SystemExit(f"roles.py: unknown role {name!r} (known: {', '.join(r.lower() for r in spec.roles)})")
+
+
+def role_config(spec, role: str) -> str:
+    """#defines for one role's firmware: its first node's address, bus timing, backoff rank and slot."""
+    node = spec.role_nodes(role)[0]
+    lines = [
+        f"/* Build configuration of role {role}, derived from the spec by firmware/roles.py. */",
+        f"#ifndef FW_ROLE_CONFIG_H",
+        f"#define FW_ROLE_CONFIG_H",
+        f"#define FW_OWN_ADDRESS 0x{node.address:02X}u /* {node.short} */",
+    ]
+    if node.bus is not None:
+        bus = spec.buses[node.bus]
+        master = spec.node(bus.master)
+        slaves = sorted(n.address for n in spec.slaves(node.bus))
+        rank = slaves.index(node.address)
+        slot_us = bus.frame_time_us(spec.frame.overhead) + bus.turnaround_us
+        lines += [
+            f"/* bus {bus.name}: {bus.long}, seed {bus.section} */",
+            f"#define FW_BAUD {bus.baud}UL",
+            f"#define FW_BITS_PER_CHAR {bus.bits_per_char}u",
+            f"#define FW_CHAR_US {round(bus.char_time_us)}UL",
+            f"#define FW_TURNAROUND_US {round(bus.turnaround_us)}UL",
+            f"#define FW_IDLE_GAP_US {round(bus.idle_gap_us)}UL /* {bus.idle_gap_chars} characters */",
+            f"#define FW_MASTER_ADDRESS 0x{master.address:02X}u /* {master.short} */",
+            f"/* spec arbitration address_backoff: after a corrupt echo wait (rank + 1) slots */",
+            f"#define FW_BACKOFF_RANK {rank}u",
+            f"#define FW_BACKOFF_SLOT_US {round(slot_us)}UL",
+        ]
+    else:
+        lines += ["#define FW_BAUD 9600UL", "#define FW_BITS_PER_CHAR 10u", "#define FW_CHAR_US 1042UL",
+                  "#define FW_TURNAROUND_US 500UL", "#define FW_IDLE_GAP_US 3646UL",
+                  "#define FW_MASTER_ADDRESS 0x00u", "#define FW_BACKOFF_RANK 0u", "#define FW_BACKOFF_SLOT_US 0UL"]
+    tx_max = spec.frame.overhead + max((m.max_size for m in spec.sends(role)), default=0)
+    char_us = spec.buses[node.bus].char_time_us if node.bus else 1e6 * 10 / 9600
+    low = role.lower()
+    lines += [
+        "#ifndef FW_BASELINE  /* the hand-written baseline uses no generated code */",
+        f'#include "node_{low}.h"',
+        f"#define FW_ROLE_NODE {low}_node",
+        f"#define FW_ROLE_INIT {low}_node_init",
+        f"#define FW_ROLE_CHECK {low}_payload_check",
+        f"#define FW_ROLE_DISPATCH {low}_dispatch",
+        f"#define FW_RX_MAX ARACHNAE_RX_MAX_{role}",
+        "#endif",
+        f"#define FW_TX_MAX {tx_max}u /* largest frame the role sends */",
+        "/* the collision latch is read two characters + 2 ms after the line is released:",
+        "   the echo's last character is through, and a simulator's sync step fits too */",
+        f"#define FW_CD_WAIT_MS {math.ceil((2 * char_us + 2000) / 1000)}u",
+        "#endif", ""]
+    return "\n".join(lines)
+
+
+_PROTO = re.compile(r"^(void|arachnae_status)\s+(\w+)\((.*)\);$")
+
+
+def stub_source(role: str) -> str:
+    """Empty definitions of the callbacks node_<role>.h asks the behaviour for."""
+    header = (GEN_C / f"node_{role.lower()}.h").read_text()
+    part = header.split("---- defined by the behaviour ----", 1)[1]
+    joined = re.sub(r",\n\s+", ", ", part)     # prototypes may wrap after a comma
+    out = [f"/* Empty behaviour of role {role} (size images and fuzzing only; built by firmware/roles.py). */",
+           f'#include "node_{role.lower()}.h"', ""]
+    for line in joined.splitlines():
+        m = _PROTO.match(line.strip())
+        if not m:
+            continue
+        ret, name, args = m.groups()
+        params = [a.strip().split()[-1].lstrip("*") for a in args.split(",") if a.strip() and a.strip() != "void"]
+        body = "".join(f" (void){p};" for p in params)
+        if ret != "void":
+            body += " return ARACHNAE_OK;"
+        out.append(f"{ret} {name}({args}) {{{body} }}")
+    return "\n".join(out) + "\n"
+
+
+def fuzz_roles(spec) -> str:
+    out = ["/* Every role's payload check and dispatch (built by firmware/roles.py fuzzroles). */"]
+    out += [f'#include "node_{r.lower()}.h"' for r in spec.roles]
+    out += ["", "typedef struct {", "    const char *name;",
+            "    arachnae_payload_check_fn check;",
+            "    /* NONE if `own` is not an address of the role, else the dispatch status */",
+            "    arachnae_status (*dispatch)(uint8_t own, const uint8_t *frame, uint16_t len);",
+            "} fz_role;", ""]
+    for r in spec.roles:
+        low = r.lower()
+        out += [f"static arachnae_status fz_dispatch_{low}(uint8_t own, const uint8_t *frame, uint16_t len)", "{",
+                f"    {low}_node node;",
+                f"    if ({low}_node_init(&node, own, 0) != ARACHNAE_OK)",
+                "        return ARACHNAE_NONE;",
+                f"    return {low}_dispatch(&node, frame, len);", "}", ""]
+    out += [f"static const fz_role fz_roles[{len(spec.roles)}] = {{"]
+    out += [f'    {{"{r}", {r.lower()}_payload_check, fz_dispatch_{r.lower()}}},' for r in spec.roles]
+    out += ["};", ""]
+    return "\n".join(out)
+
+
+def main(argv: list[str]) -> int:
+    if not argv:
+        print(__doc__.strip(), file=sys.stderr)
+        return 2
+    cmd, rest = argv[0], argv[1:]
+    spec = _spec()
+    if cmd == "list":
+        print("\n".join(r.lower() for r in spec.roles))
+    elif cmd == "msgs" and len(rest) == 1:
+        print(" ".join(role_msgs(spec, find_role(spec, rest[0]))))
+    elif cmd == "config" and len(rest) == 2:
+        Path(rest[1]).parent.mkdir(parents=True, exist_ok=True)
+        Path(rest[1]).write_text(role_config(spec, find_role(spec, rest[0])))
+    elif cmd == "stubs" and len(rest) == 1:
+        out = Path(rest[0])
+        out.mkdir(parents=True, exist_ok=True)
+        for r in spec.roles:
+            (out / f"stub_{r.lower()}.c").write_text(stub_source(r))
+    elif cmd == "mk" and len(rest) == 1:
+        lines = [f"ROLES := {' '.join(r.lower() for r in spec.roles)}"]
+        lines += [f"MSGS_{r.lower()} := {' '.join(role_msgs(spec, r))}" for r in spec.roles]
+        Path(rest[0]).parent.mkdir(parents=True, exist_ok=True)
+        Path(rest[0]).write_text("\n".join(lines) + "\n")
+    elif cmd == "fuzzroles" and len(rest) == 1:
+        Path(rest[0]).parent.mkdir(parents=True, exist_ok=True)
+        Path(rest[0]).write_text(fuzz_roles(spec))
+    else:
+        print(f"roles.py: bad arguments {' '.join(argv)!r}; see the docstring", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,331 @@
+"""Software in the loop: a node's AVR firmware, run by simavr, on a bus of the 2D simulator.
+
+`SilHost` drives firmware/sil/sil_host (a libsimavr program) over a pipe in AVR
+cycles; `SilNode` is a sim2d node (the interface sim2d.sim gives a
+behaviours.runtime.Runtime: built as cls(address, transmit, hw, config), then
+start(), receive(bus, data), on_echo(bus, sent, heard)) whose behaviour is the
+firmware, so sim2d runs it like any Python node:
+
+    from firmware.sil_bridge import sil_factory
+    proc = sil_factory()(n.address, hw.transmit, hw, self.config)   # instead of behaviour_class(n.role)(...)
+
+Time: the AVR runs at 16 MHz simulated; its cycle counter is kept in step with
+the simulation clock (cycle = t * 16e6). Every SYNC_S the AVR is run up to the
+simulation time, but never past the start of a frame that is on its bus, so the
+bytes of every received frame reach its UART at the times they cross the wire
+(byte i of a frame that started at t0 is handed to the UART at t0 + i char times;
+simavr raises RXC one of its character times later). When the firmware starts
+transmitting, the AVR runs ahead without input (its receiver is off while DE is
+high, hal.h) until it releases the RS-485 driver (PD2); the frame then goes on the
+bus at the time of its first byte, or at the latest one sync period later. When
+the bus reports an echo that differs from the frame, the bridge sets the
+collision-detect latch (PC2) the firmware reads FW_CD_WAIT_MS after the frame;
+the next DE rising edge clears it, as the latch on the board does.
+"""
+from __future__ import annotations
+
+import os
+import subprocess
+import weakref
+from pathlib import Path
+from typing import Any, Callable
+
+
+FIRMWARE = Path(__file__).resolve().parent
+BUILD = FIRMWARE / "build"
+HOST = BUILD / "sil" / "sil_host"
+F_CPU = 16_000_000
+SYNC_S = 0.001            # simulated time between two syncs of the AVR with the simulation
+DE_PIN = "D2"             # RS-485 driver enable (avr/hal_avr.c)
+TEST_POINT = "B5"         # pulsed by the firmware when it detects a stimulus
+INPUT_PINS = ("C0", "C1")  # sensor switches, active low (avr/hal_avr.c)
+CD_PIN = "C2"             # collision-detect latch, set on a corrupt echo
+
+# Roles with hand-written firmware behaviour (firmware/nodes/<role>.c), i.e. what --sil accepts.
+SIL_ROLES = tuple(sorted(p.stem.upper() for p in (FIRMWARE / "nodes").glob("*.c")))
+
+
+class SilError(RuntimeError):
+    pass
+
+
+class SilHost:
+    """One simavr process running one ELF; all times in AVR cycles."""
+
+    def __init__(self, elf: Path | str, watch: tuple[str, ...] = (DE_PIN, TEST_POINT), host: Path = HOST):
+        for p, what in ((Path(host), "the simavr host"), (Path(elf), "the firmware")):
+            if not p.exists():
+                raise SilError(f"{p}: {what} is not built; run `make -C firmware sil`")
+        args = [str(host), "-f", str(F_CPU)]
+        for w in watch:
+            args += ["-w", w]
+        self.proc = subprocess.Popen(args + [str(elf)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                     stderr=subprocess.DEVNULL, text=True, bufsize=1)
+        self.cycle = 0
+        self._close = weakref.finalize(self, SilHost._stop, self.proc)
+
+    @staticmethod
+    def _stop(proc: subprocess.Popen) -> None:
+        if proc.poll() is None:
+            try:
+                proc.stdin.write("q\n")
+                proc.stdin.flush()
+                proc.wait(timeout=2)
+            except (OSError, subprocess.TimeoutExpired):
+                proc.kill()
+                proc.wait()
+
+    def close(self) -> None:
+        self._close()
+
+    def _command(self, line: str) -> list[tuple]:
+        """Send one command; return its events up to the closing 'c CYCLE'."""
+        try:
+            self.proc.stdin.write(line + "\n")
+            self.proc.stdin.flush()
+        except OSError as exc:
+            raise SilError(f"sil_host exited ({exc})") from None
+        events: list[tuple] = []
+        while True:
+            reply = self.proc.stdout.readline()
+            if not reply:
+                raise SilError(f"sil_host exited with status {self.proc.wait()} after {line!r}")
+            kind, *rest = reply.split()
+            if kind == "c":
+                self.cycle = int(rest[0])
+                return events
+            if kind == "t":
+                events.append(("t", int(rest[0]), int(rest[1], 16)))
+            elif kind == "p":
+                events.append(("p", int(rest[0]), rest[1], int(rest[2])))
+            elif kind == "m":
+                events.append(("m", int(rest[0]), int(rest[1])))
+            elif kind == "x":
+                raise SilError(f"the AVR stopped at cycle {rest[0]} (simavr state {rest[1]})")
+            else:
+                raise SilError(f"sil_host: unexpected line {reply!r}")
+
+    def run(self, cycle: int) -> list[tuple]:
+        """Run until `cycle` or the first UART byte / watched pin change, whichever comes first."""
+        return self._command(f"r {cycle}")
+
+    def run_until(self, cycle: int) -> list[tuple]:
+        events: list[tuple] = []
+        while self.cycle < cycle:
+            events += self.run(cycle)
+        return events
+
+    def inject(self, cycle: int, byte: int) -> None:
+        self._command(f"i {cycle} {byte:02x}")
+
+    def set_pin(self, pin: str, value: int) -> None:
+        self._command(f"s {pin} {1 if value else 0}")
+
+    def stack_used(self) -> int:
+        """Deepest stack use so far, bytes (RAMEND - lowest SP)."""
+        (_, min_sp, ramend), = self._command("m")
+        return ramend - min_sp
+
+
+class SilNode:
+    """A sim2d node whose behaviour is the AVR firmware of its role, run in simavr.
+
+    Same interface as a behaviours.runtime.Runtime node as sim2d.sim builds it:
+    SilNode(address, transmit, hw, config), start(), receive(bus, data),
+    on_echo(bus, sent, heard); `hw` is the node's sim2d.hardware.NodeHardware.
+    """
+
+    SCAN_S = 0.02             # input sampling, the Python TPSC's scan period (behaviours.tuning)
+
+    def __init__(self, address: int, transmit: Callable[[str, bytes], None], hw: Any, config: Any = None,
+                 elf: Path | str | None = None, sync_s: float = SYNC_S):
+        node = hw.node
+        if node.role not in SIL_ROLES:
+            raise SilError(f"{node.short}: no firmware behaviour for role {node.role} (have: {', '.join(SIL_ROLES)})")
+        self.address, self.transmit, self.hw, self.node = address, transmit, hw, node
+        self.elf = Path(elf) if elf is not None else BUILD / "avr" / f"{node.role.lower()}.elf"
+        self.sync_s = sync_s
+        self.bus_name = node.bus
+        bus = hw.sim.spec.buses[node.bus]
+        self.char_s = bus.bits_per_char / bus.baud
+        self.host = SilHost(self.elf)
+        self.frames_sent = 0
+        self.stimuli = 0
+
+    # -- time --------------------------------------------------------------
+    @property
+    def now(self) -> float:
+        return self.hw.now()
+
+    def _cycles(self, t: float) -> int:
+        return round(t * F_CPU)
+
+    def _time(self, cycle: int) -> float:
+        return cycle / F_CPU
+
+    # -- sim2d interface ------------------------------------------------------
+    def start(self) -> None:
+        self.host.set_pin(CD_PIN, 0)
+        self._inputs()
+        self.hw.after(self.sync_s, self._sync)
+        self.hw.after(self.SCAN_S, self._scan)
+
+    def receive(self, bus: str, data: bytes) -> None:
+        """Bytes heard on the bus (the whole frame, at its end): each byte reaches the UART at its time."""
+        if not self.hw.alive:
+            return
+        t0 = self.now - len(data) * self.char_s          # when the frame's first byte started
+        self._advance(t0)
+        for i, b in enumerate(data):
+            self.host.inject(max(self.host.cycle, self._cycles(t0 + i * self.char_s)), b)
+
+    def on_echo(self, bus: str, sent: bytes, heard: bytes) -> None:
+        if self.hw.alive and heard != sent:
+            self.host.set_pin(CD_PIN, 1)        # seed 3.2.2: the echo shows the frame was corrupted
+
+    # -- inputs ---------------------------------------------------------------
+    def _scan(self) -> None:
+        self._inputs()
+        self.hw.after(self.SCAN_S, self._scan)
+
+    def _inputs(self) -> None:
+        if self.node.role == "TPSC":
+            left, right = self.hw.whiskers()
+            for pin, touched in zip(INPUT_PINS, (left, right)):
+                self.host.set_pin(pin, 0 if touched else 1)      # switches to ground, pull-ups
+
+    # -- keeping the AVR in step ------------------------------------------------
+    def _sync(self) -> None:
+        if not self.hw.alive:
+            self.host.close()
+            return
+        target = self.now
+        port = self.hw.ports.get(self.bus_name)
+        if port is not None:
+            # never run past the start of a frame still on the wire: its bytes arrive at receive()
+            starts = [tx.start for tx in port.bus.active if tx.port is not port]
+            if starts:
+                target = min(target, min(starts))
+        self._advance(target)
+        self.hw.after(self.sync_s, self._sync)
+
+    def _advance(self, t: float) -> None:
+        target = self._cycles(t)
+        while self.host.cycle < target:
+            for ev in self.host.run(target):
+                self._event(ev)
+
+    def _event(self, ev: tuple) -> None:
+        if ev[0] == "t":
+            self._transmit(ev[1], ev[2])
+        elif ev[0] == "p" and ev[2] == DE_PIN and ev[3] == 1:
+            self.host.set_pin(CD_PIN, 0)
+        elif ev[0] == "p" and ev[2] == TEST_POINT and ev[3] == 1:
+            self.stimuli += 1
+            self.hw.note("stimulus", kind="whisker")
+
+    def _transmit(self, first_cycle: int, first: int) -> None:
+        """The firmware started a frame: run it, without input, until it releases the line."""
+        frame = bytearray([first])
+        quiet = self._cycles(3 * self.char_s * 1.2)       # simavr's characters are 11 bits long
+        last = first_cycle
+        while len(frame) < 300:
+            events = self.host.run(last + quiet)
+            done = False
+            for ev in events:
+                if ev[0] == "t":
+                    frame.append(ev[2])
+                    last = ev[1]
+                elif ev[0] == "p" and ev[2] == DE_PIN and ev[3] == 0:
+                    done = True
+                else:
+                    self._event(ev)
+            if done or (not events and self.host.cycle >= last + quiet):
+                break
+        self.frames_sent += 1
+        delay = max(0.0, self._time(first_cycle) - self.now)
+        self.hw.after(delay, self.transmit, self.bus_name, bytes(frame))
+
+
+def sil_factory(elf: Path | str | None = None) -> Callable[..., SilNode]:
+    """What sim2d.sim calls instead of behaviour_class(role) for a node run as firmware:
+    factory(address, hw.transmit, hw, config)."""
+    def make(address: int, transmit: Callable[[str, bytes], None], hw: Any, config: Any = None) -> SilNode:
+        return SilNode(address, transmit, hw, config, elf)
+    return make
+
+
+def check_sil_nodes(spec: Any, names: list[str]) -> None:
+    """One-line errors for --sil arguments (arachnae.errors.UserError)."""
+    from arachnae.errors import UserError
+    for name in names:
+        node = next((n for n in spec.nodes if n.short == name), None)
+        if node is None:
+            raise UserError(f"--sil {name}: no such node (e.g. TPSC, JAC(1,1))")
+        if node.role not in SIL_ROLES:
+            raise UserError(f"--sil {name}: role {node.role} has no firmware (firmware/nodes/: {', '.join(SIL_ROLES)})")
+    missing = [p for p in [HOST] + [BUILD / "avr" / f"{n.role.lower()}.elf" for n in spec.nodes if n.short in names]
+               if not p.exists()]
+    if missing:
+        raise UserError(f"--sil: {os.path.relpath(missing[0])} is not built; run `make firmware`")
+
+
+def run_scenario(path: str, sil: tuple[str, ...], seed: int | None = None, spec: Any = None):
+    """sim2d.runner.run with the nodes in `sil` run as firmware (until sim2d's CLI has --sil).
+
+    Patches two names of sim2d.sim for the run: behaviour_class (the SIL nodes get a
+    SilNode) and _receiver (a SIL node's UART hears every frame on its bus, also
+    those for other nodes, which sim2d drops before a Python node's receive()).
+    """
+    from unittest import mock
+
+    from sim2d import runner, sim
+    spec = spec or runner.load_spec_once()
+    check_sil_nodes(spec, list(sil))
+    addresses = {n.address for n in spec.nodes if n.short in sil}
+    python_class, python_receiver = sim.behaviour_class, sim._receiver
+
+    def behaviour_class(role: str):
+        cls = python_class(role)
+
+        def make(address: int, transmit: Any, hw: Any, config: Any) -> Any:
+            return sil_factory()(address, transmit, hw, config) if address in addresses else cls(address, transmit, hw, config)
+        return make
+
+    def receiver(node: Any, hw: Any) -> Any:
+        if isinstance(node, SilNode):
+            return lambda bus, t, data: node.receive(bus, data)
+        return python_receiver(node, hw)
+
+    with mock.patch.object(sim, "behaviour_class", behaviour_class), mock.patch.object(sim, "_receiver", receiver):
+        return runner.run(path, seed, spec=spec)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """python -m firmware.sil_bridge SCENARIO --sil NODE [--seed N]: one SIL run, its metrics."""
+    import argparse
+    import sys
+
+    from arachnae.errors import UserError
+    ap = argparse.ArgumentParser(prog="python -m firmware.sil_bridge", description=main.__doc__)
+    ap.add_argument("scenario")
+    ap.add_argument("--sil", action="append", required=True, help="node run as firmware (repeatable)")
+    ap.add_argument("--seed", type=int)
+    args = ap.parse_args(argv)
+    try:
+        if not Path(args.scenario).is_file():
+            raise UserError(f"{args.scenario}: no such scenario file")
+        out = run_scenario(args.scenario, tuple(args.sil), args.seed)
+    except (UserError, SilError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    m = out.result.metrics
+    print(f"{out.scenario.name} seed {out.scenario.seed} with {', '.join(args.sil)} in simavr: "
+          f"POST {m['post']['verdict']}, frames {m['frames']}, collisions {m['collisions']}")
+    for name, ok, detail in out.expectations:
+        print(f"  {'PASS' if ok else 'FAIL'} {name}: {detail}")
+    return 1 if out.failed else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,106 @@
+"""Build the named models from the spec, run them, and report in text or JSON."""
+from __future__ import annotations
+
+import json
+from typing import Any
+
+from arachnae.errors import UserError
+from model_check import msc, spec_adapter
+from model_check.engine import Result, explore
+from model_check.gcl import Model
+from model_check.models import arbitration, id_retry, post
+
+MODELS = ("arbitration", "id_retry", "post")
+
+
+def build_models(name: str, spec, variant: str = "spec", bus: str | None = None, size: int | None = None,
+                 legs: int | None = None, symmetry: bool = True, scope: str | None = None) -> list[Model]:
+    """The models `arachnae check NAME` runs; `all` is what `make check` proves."""
+    if name == "all":
+        return (build_models("arbitration", spec, variant, None, size, scope=scope)
+                + build_models("id_retry", spec, bus=None, size=size)
+                + build_models("post", spec, legs=legs, symmetry=symmetry))
+    if name == "arbitration":
+        buses = [bus] if bus else [b for b, x in spec.buses.items() if x.arbitration != "polled"]
+        return [arbitration.build(spec_adapter.arbitration(spec, b, scope), variant, size) for b in buses]
+    if name == "id_retry":
+        buses = [bus] if bus else ["first", "sensor"] if "sensor" in spec.buses else [next(iter(spec.buses))]
+        return [id_retry.build(spec_adapter.identification(spec, b), size) for b in buses]
+    if name == "post":
+        return [post.build(spec_adapter.post(spec), legs, symmetry)]
+    raise UserError(f"unknown model {name!r}; choose one of {', '.join(MODELS + ('all',))}")
+
+
+def ms(ticks: int | None, tick_us: float) -> str:
+    return "unbounded" if ticks is None else f"{ticks} ticks = {ticks * tick_us / 1000:.1f} ms"
+
+
+def summary(res: Result) -> dict[str, Any]:
+    m = res.model
+    out: dict[str, Any] = {
+        "model": m.name, "holds": res.ok, "states": res.states, "transitions": res.transitions,
+        "depth": res.depth, "seconds": round(res.seconds, 3), "states_per_s": round(res.rate),
+        "tick_us": m.tick_us, "invariants": [i.name for i in m.invariants],
+        "responses": {r.name: res.bounds.get(r.name, "not checked") for r in m.responses},
+        "never_fired": res.never_fired, "warnings": res.warnings, "notes": m.notes,
+    }
+    finite = [b for b in res.bounds.values() if isinstance(b, int)]
+    if finite and len(finite) == len(m.responses):
+        out["bound_ticks"] = max(finite)
+        out["bound_ms"] = round(max(finite) * m.tick_us / 1000, 3)
+    if res.violation:
+        v = res.violation
+        out["counterexample"] = msc.to_json(res, v)
+        out["mermaid"] = msc.to_mermaid(res, v)
+    return out
+
+
+def text(res: Result) -> str:
+    m, s = res.model, summary(res)
+    lines = [f"model {m.name}",
+             f"  states {res.states:,}  transitions {res.transitions:,}  depth {res.depth}  "
+             f"{res.seconds:.2f} s ({res.rate:,.0f} states/s)"]
+    for note in m.notes:
+        lines.append(f"  note: {note}")
+    if res.ok:
+        lines.append(f"  invariants hold: {', '.join(i.name for i in m.invariants) or '-'}")
+        lines.append("  no deadlock")
+        for name, b in res.bounds.items():
+            lines.append(f"  {name}: holds, bound {ms(b, m.tick_us)}" if b is not None
+                         else f"  {name}: holds under weak fairness only (no tick bound)")
+        if "bound_ticks" in s:
+            lines.append(f"  K = {s['bound_ticks']} ticks = {s['bound_ms']} ms (tick {m.tick_us:.1f} us)")
+    lines.append(f"  never fired: {', '.join(res.never_fired) if res.never_fired else 'none (every rule fired)'}")
+    for w in res.warnings:
+        lines.append(f"  WARNING: {w}")
+    if res.violation:
+        v = res.violation
+        lines.append(f"  VIOLATED {v.kind}: {v.prop}" + (f" -- {v.detail}" if v.detail else ""))
+        lines.append("  counterexample (Mermaid sequenceDiagram):")
+        lines += ["    " + x for x in s["mermaid"].splitlines()]
+    else:
+        lines.append("  ALL PROPERTIES HOLD")
+    return "\n".join(lines)
+
+
+def run_check(args) -> int:
+    spec = spec_adapter.load(args.spec)
+    if args.variant == "seed" and args.model not in ("arbitration", "all"):
+        raise UserError("--variant seed applies to the arbitration model only")
+    models = build_models(args.model, spec, args.variant, args.bus, args.size, args.legs, not args.no_symmetry,
+                          args.scope)
+    results, ok = [], True
+    for model in models:
+        res = explore(model, progress=not args.quiet)
+        ok &= res.ok
+        results.append(res)
+        if not args.json:
+            print(text(res), flush=True)
+        if args.promela:
+            from model_check import promela
+            path = f"{args.promela.rstrip('/')}/{model.name.split('[')[0]}_{len(results)}.pml"
+            with open(path, "w") as fh:
+                fh.write(promela.emit(model))
+    if args.json:
+        print(json.dumps([summary(r) for r in results], indent=2))
+    return 0 if ok else 1

@@ -1,0 +1,193 @@
+"""POST (seed 6.3): hierarchical identification and the verdict, over every node condition.
+
+The MCP tests itself, then identifies its slaves in address order; a sub-master
+that answers identifies its own slaves the same way and reports upward with
+POST_REPORT (SPEC-NOTES decision 2). Each identification is one step with the
+outcomes the id_retry model proves the ID_REQ/timeout/retry exchange can end
+in: present (ID_ACK), absent or mute (no ID_ACK after the retry) and
+out-of-order (ID_ACK but a status in post.inactive_statuses). A mute or
+out-of-order sub-master is never heard, so what its own slaves do cannot reach
+the MCP and is not explored. The NODES table starts all-inactive (seed 3.2.2)
+and the verdict is computed from it by the spec's rule; an independent oracle
+recomputes the verdict from the node conditions and the hierarchy.
+
+Children that share role, status and subtree shape (the legs, the joints of a
+leg) are identified in any order and declared symmetric, so the full network
+is decided with symmetry reduction.
+"""
+from __future__ import annotations
+
+from model_check.expr import all_of, any_of, count_of
+from model_check.gcl import Event, Invariant, Model, Rule, SymGroup, Var
+from model_check.spec_adapter import PostNode, PostParams
+
+UNTESTED, OK, MISSING = 0, 1, 2
+VERDICT = {"OPERATIONAL": 1, "DEGRADED": 2, "HALTED": 3}
+OUTCOMES = ("absent", "mute", "out_of_order")
+
+
+class Tree:
+    def __init__(self, p: PostParams, legs: int | None):
+        self.p = p
+        keep = [n for n in p.nodes if legs is None or n.leg is None or n.leg <= legs]
+        self.by = {n.short: n for n in keep}
+        self.children: dict[str, list[PostNode]] = {n.short: [] for n in keep}
+        for n in keep:
+            if n.master is not None:
+                self.children[n.master].append(n)
+        self.var = {}
+        self.order: list[PostNode] = []
+        self._number(p.root)
+
+    def _number(self, short: str) -> None:
+        """DFS order; the leg/joint blocks come out contiguous for the symmetry groups."""
+        for c in self.children[short]:
+            self.var[c.short] = f"x{len(self.var)}"
+            self.order.append(c)
+            self._number(c.short)
+
+    def shape(self, short: str) -> tuple:
+        n = self.by[short]
+        return (self.p.roles[short], n.required, tuple(sorted(self.shape(c.short) for c in self.children[short])))
+
+    def symmetric(self, short: str) -> bool:
+        kids = self.children[short]
+        return len(kids) > 1 and len({self.shape(c.short) for c in kids}) == 1
+
+    def subtree(self, short: str) -> list[str]:
+        out = []
+        for c in self.children[short]:
+            out.append(c.short)
+            out += self.subtree(c.short)
+        return out
+
+
+def build(p: PostParams, legs: int | None = None, symmetry: bool = True) -> Model:
+    t = Tree(p, legs)
+    x = t.var
+    vs = [Var("mcp", 2, doc="MCP self test: 0 pending, 1 passed, 2 failed")]
+    vs += [Var(x[n.short], 2, doc=f"NODES[{n.short}]: 0 not asked, 1 active, 2 missing") for n in t.order]
+    vs.append(Var("vd", 3, doc="verdict: 0 none, 1 OPERATIONAL, 2 DEGRADED, 3 HALTED"))
+    root = p.root
+    rules = [Rule("mcp_selftest_pass", "mcp == 0", (("mcp", "1"),), actor="MCP", msc=(Event(root, None, "self test passed"),)),
+             Rule("mcp_selftest_fail", "mcp == 0", (("mcp", "2"),), actor=None, msc=(Event(root, None, "self test failed"),))]
+
+    def decided(short: str) -> str:
+        """The sub-tree of `short` has been identified and reported."""
+        kids = t.children[short]
+        own = f"{x[short]} != {UNTESTED}" if short != root else "mcp == 1"
+        if not kids:
+            return own
+        inner = all_of(decided(c.short) for c in kids)
+        return f"{own} and ({x[short]} == {MISSING} or ({inner}))" if short != root else f"{own} and ({inner})"
+
+    def may_probe(parent: str, k: int) -> str:
+        kids = t.children[parent]
+        up = "mcp == 1" if parent == root else f"{x[parent]} == {OK}"
+        if t.symmetric(parent):
+            # interchangeable siblings: any order, one sub-tree at a time (one master, one bus)
+            busy = [f"({x[c.short]} == {OK} and not ({decided(c.short)}))" for c in kids if t.children[c.short]]
+            return f"{up} and not ({any_of(busy)})" if busy else up
+        prev = kids[k - 1].short if k else None
+        return f"{up} and ({decided(prev)})" if prev else up
+
+    for parent in [root] + [n.short for n in t.order]:
+        for k, c in enumerate(t.children[parent]):
+            g = f"{x[c.short]} == {UNTESTED} and {may_probe(parent, k)}"
+            # seed 3.2.2: ID_REQ, 10 ms, one retry (proved by the id_retry model); seed 6.3: report upward
+            rules.append(Rule(f"id_{c.short}_present", g, ((x[c.short], str(OK)),), actor=parent,
+                              msc=(Event(parent, c.short, "ID_REQ"), Event(c.short, parent, "ID_ACK"))))
+            for o in OUTCOMES:
+                rules.append(Rule(f"id_{c.short}_{o}", g, ((x[c.short], str(MISSING)),), actor=None,
+                                  msc=(Event(parent, c.short, "ID_REQ"),
+                                       Event(c.short, parent, "ID_ACK OUT_OF_ORDER" if o == "out_of_order"
+                                             else f"no ID_ACK after the retry ({o})"))))
+
+    # the verdict, by the spec's rule over the NODES table
+    everything = [n.short for n in t.order]
+    units: dict[tuple[str, int], list[str]] = {}
+    for name, key, _, roles in p.quorums:
+        for s in everything:
+            n = t.by[s]
+            if p.roles[s] in roles and getattr(n, key) is not None:
+                units.setdefault((name, getattr(n, key)), []).append(s)
+    in_quorum = {s for members in units.values() for s in members}
+    missing = {s: f"{x[s]} != {OK}" for s in everything}
+    quorum_low, quorum_short = [], []
+    for name, key, least, _ in p.quorums:
+        mine = [m for (q, _), m in units.items() if q == name]
+        complete = count_of(all_of(f"{x[s]} == {OK}" for s in m) for m in mine)
+        quorum_low.append(f"({complete}) < {least}")            # seed 6.3: at least five legs
+        quorum_short.append(f"({complete}) < {len(mine)}")
+    halted = any_of(["mcp == 2"] + [missing[s] for s in everything if t.by[s].required and s not in in_quorum]
+                    + quorum_low)
+    degraded = any_of([missing[s] for s in everything if not t.by[s].required] + quorum_short)
+    ready = f"vd == 0 and (mcp == 2 or ({decided(root)}))"
+    rules += [
+        Rule("verdict_HALTED", f"{ready} and ({halted})", (("vd", "3"),), actor="MCP",
+             msc=(Event(root, None, "POST verdict HALTED"),)),
+        Rule("verdict_DEGRADED", f"{ready} and not ({halted}) and ({degraded})", (("vd", "2"),), actor="MCP",
+             msc=(Event(root, None, "POST verdict DEGRADED"),)),
+        Rule("verdict_OPERATIONAL", f"{ready} and not ({halted}) and not ({degraded})", (("vd", "1"),),
+             actor="MCP", msc=(Event(root, None, "POST verdict OPERATIONAL"),)),
+    ]
+    invs = [Invariant("verdict_only_when_done", f"vd == 0 or mcp == 2 or ({decided(root)})"),
+            Invariant("failed_mcp_halts", "vd == 0 or mcp != 2 or vd == 3")]
+    sym: list[SymGroup] = []
+    if symmetry:
+        for parent in [n.short for n in t.order]:          # inner groups (joints) first ...
+            if t.symmetric(parent) and not any(t.children[c.short] for c in t.children[parent]):
+                sym.append(SymGroup(f"children of {parent}", tuple((x[c.short],) for c in t.children[parent])))
+        for parent in [root] + [n.short for n in t.order]:  # ... then the groups containing them
+            if t.symmetric(parent) and any(t.children[c.short] for c in t.children[parent]):
+                blocks = tuple(tuple(x[s] for s in [c.short] + t.subtree(c.short)) for c in t.children[parent])
+                sym.append(SymGroup(f"subtrees under {parent}", blocks))
+    names = {x[s]: s for s in everything}
+    model = Model(name=f"post[{len(everything) + 1} nodes{', symmetry' if sym else ''}]", vars=vs, rules=rules,
+                  invariants=invs, final="vd != 0", symmetry=sym, participants=[root] + everything[:0],
+                  notes=["seed 6.3 POST; each identification abstracted to its outcome (see id_retry)"])
+    model.final_checks.append(("verdict_matches_oracle", lambda v: oracle_mismatch(p, t, names, v)))
+    return model
+
+
+def oracle_mismatch(p: PostParams, t: Tree, names: dict[str, str], values: dict[str, int]) -> str | None:
+    """Independent oracle: verdict and missing required nodes straight from conditions and the hierarchy."""
+    cond = {names[k]: v for k, v in values.items() if k in names}
+
+    def present(s: str) -> bool:
+        n = t.by[s]
+        up = values["mcp"] == 1 if n.master == p.root else present(n.master)
+        return up and cond[s] == OK
+
+    absent = [s for s in cond if not present(s)]
+    if values["mcp"] == 2:
+        expect, named = "HALTED", {p.root}
+    else:
+        named = {s for s in absent if t.by[s].required}
+        expect = "OPERATIONAL"
+        for name, key, least, roles in p.quorums:
+            groups: dict[int, list[str]] = {}
+            for s in cond:
+                if p.roles[s] in roles and getattr(t.by[s], key) is not None:
+                    groups.setdefault(getattr(t.by[s], key), []).append(s)
+            whole = sum(all(present(s) for s in g) for g in groups.values())
+            outside = named - {s for g in groups.values() for s in g}
+            if whole < least or outside:
+                expect = "HALTED"
+            elif whole < len(groups) and expect != "HALTED":
+                expect = "DEGRADED"
+            if not (whole < least):
+                named -= {s for g in groups.values() for s in g}   # a tolerated missing leg is no reason to halt
+        if expect != "HALTED" and any(not t.by[s].required for s in absent):
+            expect = "DEGRADED"
+        if not p.quorums and named:
+            expect = "HALTED"
+    got = {v: k for k, v in VERDICT.items()}[values["vd"]]
+    reported = {p.root} if values["mcp"] == 2 else {s for s in cond if t.by[s].required and cond[s] != OK}
+    if expect == "HALTED" and got == "HALTED":
+        if values["mcp"] != 2 and not (named <= reported):
+            return f"HALTED report {sorted(reported)} does not name {sorted(named - reported)}"
+        return None
+    if got != expect:
+        return f"verdict {got}, oracle says {expect} (missing: {sorted(absent)})"
+    return None

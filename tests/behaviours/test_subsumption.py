@@ -1,0 +1,176 @@
+"""Subsumption library (decision 8, seed 5.2): suppression, inhibition, the control trace, the NP3 network."""
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from arachnae_proto.enums import MovCmd
+from behaviours.subsumption import (
+    AVOIDANCE, NONE_LAYER, REFLEXES, TASK, FunctionModule, Network, np3_network, whiskers_from_tpsc,
+)
+
+
+class FakeClock:
+    def __init__(self, t: float = 0.0) -> None:
+        self.t = t
+
+    def __call__(self) -> float:
+        return self.t
+
+
+def run(net: Network, clock: FakeClock, until: float, dt: float = 0.1, each=None) -> list[tuple[float, object]]:
+    """Step the network every dt up to `until` (exclusive); returns (time, move) after each step."""
+    out = []
+    while clock.t < until - 1e-9:
+        if each:
+            each(clock.t)
+        out.append((round(clock.t, 6), net.step()["move"]))
+        clock.t = round(clock.t + dt, 6)
+    return out
+
+
+def two_layer_net(clock: FakeClock, kind: str, hold_s: float) -> Network:
+    """A 'low' module always sending 'low'; a 'high' one sending 'high' while sensor `go` is set."""
+    net = Network(clock)
+    net.add(FunctionModule("low", "task", (), ("move",), lambda i, now: {"move": "low"}))
+    net.add(FunctionModule("high", "reflexes", ("go",), ("move",),
+                           lambda i, now: {"move": "high" if i["go"] else None}))
+    net.wire("sensor.go", "high.go")
+    net.wire("low.move", net.actuator("move"))
+    if kind == "suppress":
+        net.suppress("high.move", "actuator.move", hold_s)
+    else:
+        net.inhibit("high.move", "low.move", hold_s)
+    net.sense(go=False)
+    return net
+
+
+def test_suppression_replaces_the_input_and_holds_for_its_time_constant():
+    clock = FakeClock()
+    net = two_layer_net(clock, "suppress", hold_s=1.0)
+    log = run(net, clock, 3.0, each=lambda t: net.sense(go=0.5 <= t < 1.0))
+    moves = dict(log)
+    assert moves[0.4] == "low"
+    assert moves[0.5] == "high"                     # replaced in the same step
+    # last 'high' message at 0.9 s: the wire stays cut until 1.9 s, so the actuator keeps 'high'
+    assert all(moves[t] == "high" for t in moves if 0.5 <= t < 1.9)
+    assert moves[1.9] == "low" and moves[2.5] == "low"   # released after the time constant
+
+
+def test_inhibition_blocks_the_lower_output_without_replacing_it():
+    clock = FakeClock()
+    net = two_layer_net(clock, "inhibit", hold_s=0.5)
+    delivered = {}
+    for t10 in range(30):
+        clock.t = t10 / 10
+        net.sense(go=10 <= t10 < 15)                 # 'high' speaks from 1.0 to 1.4 s
+        net.step()
+        delivered[clock.t] = net.delivered["move"]
+    blocked = sorted(t for t, port in delivered.items() if port is None)
+    # 'low' is blocked from the first 'high' message until 0.5 s after the last one (1.4 + 0.5)
+    assert blocked == pytest.approx([t10 / 10 for t10 in range(10, 19)])
+    assert delivered[0.9] == delivered[1.9] == "low.move"
+    # the inhibitor's own message never reaches the actuator: the value held is still 'low'
+    assert net.actuators["move"] == "low"
+    assert [iv.module for iv in net.trace("move").intervals()] == ["low"]
+
+
+def test_trace_intervals_cover_the_run_and_summary_sums_per_layer():
+    clock = FakeClock(2.0)
+    net = np3_network(clock, task="forward")
+    net.sense(battery_v=4.8, tilt=(0.0, 0.0), whiskers=(False, False), ir=(None, None, None))
+
+    def world(t: float) -> None:
+        net.sense(whiskers=(True, False) if 5.0 <= t < 5.3 else (False, False),
+                  ir=(None, 0.3, None) if 15.0 <= t < 15.3 else (None, None, None))
+
+    run(net, clock, 30.0, each=world)
+    trace = net.trace("move")
+    ivs = trace.intervals(until=30.0)
+    assert ivs[0].start == pytest.approx(2.0) and ivs[-1].end == pytest.approx(30.0)
+    for a, b in zip(ivs, ivs[1:]):
+        assert a.end == pytest.approx(b.start)      # no gaps, no overlaps
+    assert sum(iv.duration for iv in ivs) == pytest.approx(28.0)
+    summary = trace.summary(until=30.0)
+    assert sum(summary.values()) == pytest.approx(28.0)
+    assert set(summary) == {TASK, REFLEXES, AVOIDANCE}
+    # the contact reflex's manoeuvre is 1.6 + 3.2 s, plus its suppressor's hold of 0.5 s
+    assert summary[REFLEXES] == pytest.approx(1.6 + 3.2 + 0.5 - 0.1, abs=0.11)
+    assert NONE_LAYER not in summary                # the task drives from the very first step
+
+
+def test_a_reflex_pre_empts_the_task_in_the_same_step():
+    clock = FakeClock()
+    net = np3_network(clock, task="forward")
+    net.sense(whiskers=(False, False))
+    assert net.step()["move"] == MovCmd.FORWARD
+    clock.t = 0.1
+    net.sense(whiskers=(True, False))                # seed 3.2.12: OBJ_LEFT
+    assert net.step()["move"] == MovCmd.BACKWARD     # 5.2: reaction well within 1 s: this very step
+    assert net.trace("move").current == (0.1, REFLEXES, "contact")   # (since, layer, module)
+    clock.t = 1.8                                    # after backing off it turns away from the left contact
+    net.sense(whiskers=(False, False))
+    assert net.step()["move"] == MovCmd.TURN_RIGHT
+
+
+def test_stop_reflexes_win_over_backing_off():
+    clock = FakeClock()
+    net = np3_network(clock, task="forward")
+    net.sense(whiskers=(True, True), battery_v=4.3)  # contact and under-voltage at once (3.2.17: stop)
+    assert net.step()["move"] == MovCmd.STOP
+    net.sense(battery_v=4.8, whiskers=(False, False))
+    clock.t = 0.3                                    # still within the battery suppressor's hold
+    assert net.step()["move"] == MovCmd.STOP
+
+
+def test_avoidance_turns_away_from_the_nearer_side_and_task_resumes():
+    clock = FakeClock()
+    net = np3_network(clock, task="forward")
+    net.sense(ir=(0.2, None, None))                  # obstacle on the left, not yet a contact
+    assert net.step()["move"] == MovCmd.TURN_RIGHT
+    net.sense(ir=(None, None, None))
+    clock.t = 0.1
+    log = dict(run(net, clock, 5.0))
+    resumed = min(t for t, v in log.items() if v == MovCmd.FORWARD)
+    assert resumed == pytest.approx(1.6 + 0.5, abs=0.11)   # turn plan, then the hold releases
+
+
+def test_wiring_table_lists_every_declared_connection():
+    net = np3_network(FakeClock(), task="explore")
+    table = net.wiring_table()
+    lines = table.splitlines()
+    assert lines[0].split() == ["kind", "from", "to", "hold", "s"]
+    assert any(l.split()[:3] == ["wire", "task.move", "actuator.move"] for l in lines)
+    assert any(l.split() == ["suppress", "avoid.move", "actuator.move", "0.5"] for l in lines)
+    assert sum(1 for l in lines if l.startswith("suppress")) == 1 + 6   # avoidance + six reflexes
+    assert len(lines) == 2 + len(net.wires) + len(net.nodes)
+
+
+def test_cycles_and_bad_ports_are_rejected():
+    net = Network(FakeClock())
+    net.add(FunctionModule("a", "x", ("i",), ("o",), lambda i, now: {"o": 1}))
+    net.add(FunctionModule("b", "x", ("i",), ("o",), lambda i, now: {"o": 1}))
+    with pytest.raises(ValueError):
+        net.wire("a.nope", "b.i")
+    net.wire("a.o", "b.i")
+    net.wire("b.o", "a.i")
+    with pytest.raises(ValueError, match="cycle"):
+        net.step()
+
+
+def test_tpsc_byte_decodes_to_whiskers():
+    assert whiskers_from_tpsc(0x10) == (True, False)
+    assert whiskers_from_tpsc(0x20) == (False, True)
+    assert whiskers_from_tpsc(0x40) == (True, True)
+    assert whiskers_from_tpsc(0x00) == (False, False)
+
+
+def test_explore_turns_periodically():
+    clock = FakeClock()
+    net = np3_network(clock, task="explore")
+    log = run(net, clock, 45.0)
+    turns = [t for t, v in log if v == MovCmd.TURN_LEFT]
+    assert turns and math.isclose(turns[0], 20.0, abs_tol=1e-6)
+    assert any(abs(t - 40.0) < 1e-6 for t in turns)
+    assert len(turns) == 2 * 16                      # 1.6 s each at 10 Hz

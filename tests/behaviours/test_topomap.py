@@ -1,0 +1,157 @@
+"""NP3 topological map (seed 3.3.2) from synthetic ultrasonic scans of known rooms."""
+from __future__ import annotations
+
+import math
+
+import pytest
+from PIL import Image
+
+from behaviours.topomap import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, Reading, TopoMap, full_scan
+
+Segment = tuple[tuple[float, float], tuple[float, float]]
+
+
+def box(x0: float, y0: float, x1: float, y1: float) -> list[Segment]:
+    return [((x0, y0), (x1, y0)), ((x1, y0), (x1, y1)), ((x1, y1), (x0, y1)), ((x0, y1), (x0, y0))]
+
+
+def cast(walls: list[Segment], x: float, y: float, angle: float, max_range: float = 10.0) -> float | None:
+    """Distance to the first wall along the ray (None beyond the USRC's 10 m, seed 3.2.11)."""
+    dx, dy = math.cos(angle), math.sin(angle)
+    best = None
+    for (ax, ay), (bx, by) in walls:
+        ex, ey = bx - ax, by - ay
+        den = dx * ey - dy * ex
+        if abs(den) < 1e-12:
+            continue
+        t = ((ax - x) * ey - (ay - y) * ex) / den        # along the ray
+        u = ((ax - x) * dy - (ay - y) * dx) / den        # along the wall
+        if t > 0 and 0 <= u <= 1 and (best is None or t < best):
+            best = t
+    return best if best is not None and best < max_range else None
+
+
+def scan(walls: list[Segment], x: float, y: float, heading_deg: float = 0.0) -> list[Reading]:
+    ranges = [cast(walls, x, y, math.radians(heading_deg + k)) for k in range(360)]
+    return full_scan(x, y, heading_deg, ranges)
+
+
+ROOM = box(0, 0, 6, 6)
+ROOM_POLY = [(0, 0), (6, 0), (6, 6), (0, 6)]
+POSES = [(1.5, 1.5, 0), (4.5, 1.5, 90), (3.0, 3.0, 45), (1.5, 4.5, 180), (4.5, 4.5, 270)]
+
+
+def new_map(room=None, width=7.0, height=7.0) -> TopoMap:
+    return TopoMap(OccupancyGrid(-0.5, -0.5, width, height, 0.1), robot_radius_m=0.25, place_spacing_m=1.0, room=room)
+
+
+@pytest.fixture(scope="module")
+def square_room() -> TopoMap:
+    m = new_map(ROOM_POLY)
+    for pose in POSES:
+        m.add_scan(scan(ROOM, *pose))
+    return m
+
+
+def distance_to_walls(walls: list[Segment], x: float, y: float) -> float:
+    def seg(p, a, b):
+        (px, py), (ax, ay), (bx, by) = p, a, b
+        t = max(0.0, min(1.0, ((px - ax) * (bx - ax) + (py - ay) * (by - ay)) / ((bx - ax) ** 2 + (by - ay) ** 2)))
+        return math.hypot(px - ax - t * (bx - ax), py - ay - t * (by - ay))
+    return min(seg((x, y), a, b) for a, b in walls)
+
+
+def test_walls_appear_in_the_grid_where_they_are(square_room):
+    g = square_room.grid
+    occupied = [(i, j) for j in range(g.ny) for i in range(g.nx) if g.state(i, j) == OCCUPIED]
+    assert occupied
+    # every occupied cell lies on a wall (within one cell diagonal)
+    assert max(distance_to_walls(ROOM, *g.centre(i, j)) for i, j in occupied) <= 0.15
+    # and the walls are (almost) continuously marked: sample every 10 cm along them
+    samples = [(x / 10, y) for x in range(1, 60) for y in (0.0, 6.0)]
+    samples += [(x, y / 10) for y in range(1, 60) for x in (0.0, 6.0)]
+    marked = sum(any(g.state(*g.cell(sx + dx, sy + dy)) == OCCUPIED for dx in (-0.05, 0.05) for dy in (-0.05, 0.05))
+                 for sx, sy in samples)
+    assert marked / len(samples) > 0.95
+    # the inside is free, the outside unknown
+    assert g.state_at(3.05, 3.05) == FREE and g.state_at(0.55, 5.45) == FREE
+    assert g.state_at(-0.35, 3.0) == UNKNOWN and g.state_at(6.35, 6.35) == UNKNOWN
+
+
+def test_places_lie_in_free_space_and_one_room_is_one_connected_graph(square_room):
+    places = square_room.places
+    assert len(places) >= 16                         # about one per square metre of a 6 m x 6 m room
+    for p in places:
+        assert 0 < p.x < 6 and 0 < p.y < 6
+        assert distance_to_walls(ROOM, p.x, p.y) >= 0.25 - 0.1   # robot radius, within a cell
+    assert square_room.component(places[0].id) == {p.id for p in places}
+
+
+def two_rooms(door: bool) -> tuple[TopoMap, list[Segment]]:
+    walls = box(0, 0, 8, 4)
+    walls += [((4, 0), (4, 1.5)), ((4, 2.5), (4, 4))] if door else [((4, 0), (4, 4))]
+    m = new_map(width=9.0, height=5.0)
+    for pose in [(2, 2, 0), (1, 1, 0), (1, 3, 0), (6, 2, 0), (7, 1, 0), (7, 3, 0), (3, 2, 0), (5, 2, 0)]:
+        m.add_scan(scan(walls, *pose))
+    return m, walls
+
+
+def test_graph_never_crosses_a_wall_and_connects_through_a_door():
+    closed, _ = two_rooms(door=False)
+    left = {p.id for p in closed.places if p.x < 4}
+    right = {p.id for p in closed.places if p.x > 4}
+    assert left and right and not left & right
+    by_id = {p.id: p for p in closed.places}
+    for a, b in closed.edges:
+        assert (by_id[a].x < 4) == (by_id[b].x < 4), "edge through the wall"
+    some_left = min(left)
+    assert closed.component(some_left) == left       # the left room is one connected graph
+    assert closed.component(min(right)) == right
+
+    opened, _ = two_rooms(door=True)
+    ids = {p.id for p in opened.places}
+    assert opened.component(min(ids)) == ids         # a 1 m door lets the robot (r = 0.25 m) through
+
+
+def test_coverage_grows_monotonically_with_more_scans():
+    # two rooms without a door: scans in the left room cannot see the right one
+    walls = box(0, 0, 8, 4) + [((4, 0), (4, 4))]
+    m = new_map(room=[(0, 0), (8, 0), (8, 4), (0, 4)], width=9.0, height=5.0)
+    shares = [m.coverage()]
+    for pose in [(2, 2, 0), (1, 1, 0), (6, 2, 0), (7, 3, 0)]:
+        m.add_scan(scan(walls, *pose))
+        shares.append(m.coverage())
+    assert shares[0] == 0.0
+    assert all(b >= a for a, b in zip(shares, shares[1:]))
+    assert 0.4 < shares[1] < 0.6                     # the left half
+    assert shares[3] > shares[2] and shares[-1] > 0.95
+
+
+def test_frontier_points_into_unknown_space_and_vanishes_when_explored():
+    # a corridor room seen only from its left end: the unexplored right part is the frontier
+    walls = box(0, 0, 12, 2)
+    m = TopoMap(OccupancyGrid(-0.5, -0.5, 13.0, 3.0, 0.1))
+    m.add_scan(scan(walls, 1.0, 1.0))
+    f = m.frontier(1.0, 1.0)
+    assert f is not None and f.x > 5.0 and f.size >= 5     # towards the unseen right end, not at the walls
+    assert f.path_m == pytest.approx(f.x - 1.0, abs=1.0)
+    for x in (5.0, 9.0, 11.0):
+        m.add_scan(scan(walls, x, 1.0))
+    assert m.frontier(11.0, 1.0) is None
+
+
+def test_png_has_the_grid_size_and_shows_walls_places_and_unknown(tmp_path, square_room):
+    out = square_room.save_png(tmp_path / "map.png", px_per_cell=4)
+    img = Image.open(out)
+    g = square_room.grid
+    assert img.format == "PNG" and img.size == (g.nx * 4, g.ny * 4)
+    rgb = img.convert("RGB")
+
+    def pixel(x: float, y: float) -> tuple[int, int, int]:
+        i, j = g.cell(x, y)
+        return rgb.getpixel((i * 4 + 2, (g.ny - 1 - j) * 4 + 2))
+
+    assert pixel(-0.35, -0.35) == (160, 160, 160)            # unknown outside the room
+    assert pixel(-0.35, 3.0) == (160, 160, 160)
+    colours = {rgb.getpixel((u, v)) for u in range(img.size[0]) for v in range(img.size[1])}
+    assert (0, 0, 0) in colours and (220, 30, 30) in colours and (255, 255, 255) in colours

@@ -1,0 +1,29 @@
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+FIRMWARE = REPO / "firmware"
+if str(REPO) not in sys.path:
+    sys.path.insert(0, str(REPO))
+
+
+def make(*targets: str, **variables: str) -> subprocess.CompletedProcess:
+    """make -C firmware; a failure shows the compiler's last lines."""
+    args = ["make", "-C", str(FIRMWARE), "-j2", f"PYTHON={sys.executable}", *targets]
+    args += [f"{k}={v}" for k, v in variables.items()]
+    r = subprocess.run(args, capture_output=True, text=True)
+    if r.returncode != 0:
+        pytest.fail(f"{' '.join(args)} failed:\n{r.stdout[-3000:]}\n{r.stderr[-3000:]}")
+    return r
+
+
+@pytest.fixture(scope="session")
+def firmware_built() -> Path:
+    """The whole build matrix, every role image and the SIL programs (incremental)."""
+    make("all")
+    return FIRMWARE / "build"

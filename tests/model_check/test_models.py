@@ -1,0 +1,98 @@
+"""The three protocol models, built from the spec, against the properties issue 3 names."""
+import pytest
+
+from model_check import spec_adapter as sa
+from model_check.engine import explore
+from model_check.models import arbitration, id_retry, post
+
+
+def test_seed_arbitration_collides_forever_with_two_slaves(spec):
+    res = explore(arbitration.build(sa.arbitration(spec, "sensor"), "seed", 2), progress=False)
+    v = res.violation
+    assert v is not None and v.kind == "liveness" and v.prop.startswith("served_")
+    cycle = [res.model.rules[s.rule].name for s in v.trace[v.loop_start + 1:]]
+    assert cycle and set(cycle) == {"collision"}     # the lockstep retry, forever
+
+
+def test_spec_rule_as_written_lets_a_slave_collide_without_bound(spec):
+    """Only the colliders back off: a fresh request of a low rank keeps hitting the old one."""
+    p = sa.arbitration(spec, "sensor", "colliders")
+    res = explore(arbitration.build(p, "spec", 2), progress=False)
+    assert res.violation is not None and res.violation.prop == "collisions_bounded"
+
+
+@pytest.mark.parametrize("bus", ["first", "sensor"])
+def test_spec_arbitration_with_window_is_safe_and_bounded(spec, bus):
+    p = sa.arbitration(spec, bus, "all")
+    res = explore(arbitration.build(p, "spec"), progress=False)
+    assert res.ok, res.violation
+    assert res.never_fired == []
+    bounds = res.bounds
+    assert len(bounds) == len(p.slaves) and all(isinstance(k, int) and k > 0 for k in bounds.values())
+    # a request can never be served faster than its own request slot plus its session
+    for s in p.slaves:
+        assert bounds[f"served_{s.short}"] >= 1 + s.fetch_slots + s.deliver_slots
+    # the highest rank waits longest after a collision
+    assert bounds[f"served_{p.slaves[-1].short}"] == max(bounds.values())
+
+
+def test_arbitration_numbers_come_from_the_spec(spec):
+    p = sa.arbitration(spec, "sensor")
+    bus = spec.buses["sensor"]
+    assert [s.short for s in p.slaves] == sorted(bus.slaves, key=lambda s: spec.node(s).address)
+    req = spec.message(p.request)
+    assert p.slot_us == pytest.approx((spec.frame.overhead + req.max_size) * bus.char_time_us + bus.turnaround_us)
+
+
+def test_id_retry_two_nodes_holds_with_bound_of_two_windows(spec):
+    p = sa.identification(spec, "first")
+    res = explore(id_retry.build(p, 2), progress=False)
+    assert res.ok, res.violation
+    window = p.req_ticks + p.timeout_ticks
+    for name in p.slaves[:2]:
+        assert res.bounds[f"decided_{name}"] == (p.retries + 1) * window   # at most two timeouts
+    assert res.bounds["round_complete"] == 2 * (p.retries + 1) * window
+    assert res.never_fired == []          # late, stale and lost ACKs all happen
+
+
+def test_id_retry_catches_a_master_that_ignores_the_address(spec):
+    """Mutation: accept any ACK while waiting -> a late ACK marks the wrong node."""
+    m = id_retry.build(sa.identification(spec, "first"), 2)
+    for i, r in enumerate(m.rules):
+        if r.name.startswith("ack_stale_0_"):
+            m.rules[i] = type(r)(r.name, r.guard, r.effect + (("e1", "1"),), r.actor, r.ticks, r.msc)
+    m.validate()
+    res = explore(m, progress=False)
+    assert res.violation is not None and "MMC" in res.violation.prop
+
+
+def test_sensor_bus_id_ack_cannot_meet_the_timeout(spec):
+    """At 2400 baud an ID_ACK is longer than 10 ms: only a late answer to the first request is accepted."""
+    res = explore(id_retry.build(sa.identification(spec, "sensor"), 1), progress=False)
+    assert res.ok
+    assert any(n.startswith("ack_accepted_0_1") for n in res.never_fired)
+
+
+def test_post_small_network_matches_oracle_without_and_with_symmetry(spec):
+    p = sa.post(spec)
+    plain = explore(post.build(p, legs=1, symmetry=False), progress=False)
+    reduced = explore(post.build(p, legs=1, symmetry=True), progress=False)
+    assert plain.ok and reduced.ok
+    assert reduced.states < plain.states            # joints of the leg are interchangeable
+
+
+def test_post_oracle_catches_a_wrong_quorum(spec):
+    """Mutation: the model's rule tolerates two missing legs, the oracle (spec) does not."""
+    import dataclasses
+    p = sa.post(spec)
+    loose = dataclasses.replace(p, quorums=[(n, k, least - 1, r) for n, k, least, r in p.quorums])
+    model = post.build(loose, legs=None, symmetry=True)
+    tree = post.Tree(p, None)
+    names = {tree.var[s]: s for s in tree.var}
+    model.final_checks = [("oracle", lambda v: post.oracle_mismatch(p, tree, names, v))]
+    # only the legs vary (every other node answers), to keep the run short
+    model.rules = [r for r in model.rules if not r.name.startswith("id_") or r.name.endswith("_present")
+                   or r.name.startswith(("id_LCP", "id_JAC"))]
+    res = explore(model, progress=False)
+    assert res.violation is not None and res.violation.kind == "final-check"
+    assert "HALTED" in res.violation.detail
