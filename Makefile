@@ -4,7 +4,7 @@ PY       := $(VENV)/bin/python
 ARACHNAE := $(VENV)/bin/arachnae
 STAMP    := $(VENV)/.setup-stamp
 
-.PHONY: setup run test scenarios codegen spec-check check bench firmware size fuzz clean
+.PHONY: setup run test scenarios codegen spec-check check timing bench firmware size fuzz clean
 
 setup: $(STAMP)
 
@@ -16,12 +16,21 @@ $(STAMP): pyproject.toml scripts/setup.sh scripts/apt-packages.txt
 run: setup
 	$(ARACHNAE) sim run scenarios/default.yaml --out runs/default
 
-## All tests, as CI runs them.
+## All tests, as CI runs them: unit tests, scenarios, model checking, firmware matrix and fuzzing.
 test: setup
 	$(ARACHNAE) spec check
 	$(ARACHNAE) codegen --check
 	$(PY) -m pytest
-	$(MAKE) scenarios
+	$(MAKE) scenarios check firmware size fuzz
+
+## Prove the spec's protocols; the seed's arbitration rule must yield its counterexample (exit 1).
+check: setup
+	$(ARACHNAE) check all --quiet
+	$(ARACHNAE) check arbitration --variant seed --bus sensor --size 2 --quiet; test $$? -eq 1
+
+## Worst-case POST, whisker-to-STOP and scan times against the seed's bounds.
+timing: setup
+	$(ARACHNAE) timing
 
 ## The scenario library, two seeds each, every expectation must hold.
 scenarios: setup

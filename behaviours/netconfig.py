@@ -45,6 +45,9 @@ class Quorum:
 class NetConfig:
     protocol: Protocol
     arbitration: dict[str, str]            # bus -> 'address_backoff' | 'polled' | 'seed'
+    backoff_slots: int                     # spec arbitration.address_backoff: slots per rank step
+    backoff_scope: str                     # 'all' (every slave defers after a collision) | 'colliders'
+    requesters: dict[str, tuple[int, ...]]  # bus -> addresses of the slaves sending its request_message, ascending
     inactive_statuses: tuple[str, ...]     # seed 6.3: a node reporting one of these counts as missing
     quorums: tuple[Quorum, ...]
     units: dict[int, dict[str, int]]       # address -> {'leg': n, 'joint': m} where the spec gives them
@@ -67,10 +70,17 @@ class NetConfig:
         backoff = spec.arbitration.get("address_backoff", {})
         if backoff and (backoff.get("slot"), backoff.get("rank_order")) != (_BACKOFF_SLOT, _BACKOFF_ORDER):
             raise ValueError(f"arbitration.address_backoff: only slot {_BACKOFF_SLOT} ordered by {_BACKOFF_ORDER} is implemented")
+        scope = backoff.get("backoff_scope", "colliders")
+        if scope not in ("all", "colliders"):
+            raise ValueError(f"arbitration.address_backoff.backoff_scope {scope!r} is not 'all' or 'colliders'")
         return cls(
             protocol=Protocol(p.response_timeout_to, int(p.master_defer_slots), p.post_report_timeout_ms / 1000,
                               int(p.move_retries), p.setpoint_refresh_ms / 1000),
             arbitration={name: b.arbitration for name, b in spec.buses.items()},
+            backoff_slots=int(backoff.get("backoff_slots", 1)), backoff_scope=scope,
+            requesters={name: tuple(sorted(n.address for n in spec.nodes if n.bus == name
+                                           and n.role in spec.message(b.request_message).senders))
+                        for name, b in spec.buses.items() if b.request_message},
             inactive_statuses=tuple(spec.post.inactive_statuses),
             quorums=tuple(Quorum(q.name, q.unit_key, tuple(q.unit_roles), int(q.min_complete)) for q in spec.post.quorums),
             units={n.address: {k: v for k, v in (("leg", n.leg), ("joint", n.joint)) if v is not None}

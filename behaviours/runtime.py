@@ -12,7 +12,9 @@ dispatches; this adds
     `id_retries` times (seed 3.2.2: 10 ms, one retry);
   - `slave_send(...)`: a slave-initiated frame, started only on a line idle
     for longer than the turnaround, resent after a corrupt echo following the
-    bus's arbitration rule (address_backoff: rank + 1 slots).
+    bus's arbitration rule (address_backoff with scope `all`: after any corrupt
+    frame every slave waits for its own slot, rank x backoff_slots, of the window
+    that follows; the rule the model checker proves bounded).
 Bus timing comes from arachnae_proto.network.BUSES, protocol rules from the
 host-supplied NetConfig: nothing here is a number of its own.
 """
@@ -84,6 +86,7 @@ class Runtime:
         self.links: dict[str, MasterLink] = {self.master_bus: MasterLink(self.master_bus)} if self.master_bus else {}
         self._slave_out: dict[str, deque[bytes]] = {}
         self._timings: dict[str, BusTiming] = {}
+        self._collision_at: dict[str, float] = {}   # bus -> when the last corrupt frame ended
 
     # --- life cycle and time ------------------------------------------------------------
     def start(self) -> None:
@@ -212,6 +215,10 @@ class Runtime:
         q = self._slave_out.get(bus)
         if not q:
             return
+        wait = self._backoff_wait(bus)
+        if wait > 0:
+            self.hw.after(wait, self._slave_start, bus)
+            return
         t = self._timing(bus)
         idle = self.hw.line_idle_s(bus)
         if idle <= t.turnaround_s:
@@ -227,8 +234,37 @@ class Runtime:
             q.popleft()
             if q:
                 self._slave_start(bus)
+        elif self._scope_all(bus):
+            self._collision_at[bus] = self.now   # seed 3.2.2: corrupt echo; spec: wait for our slot
+            self._slave_start(bus)
         else:
             self.hw.after(self._backoff(bus), self._slave_start, bus)
+
+    def on_codec_error(self, bus: str, err: Any) -> None:
+        """A corrupt frame on one of our buses: with scope `all`, every slave enters the backoff window."""
+        if self._scope_all(bus) and bus != self.master_bus:
+            self._collision_at[bus] = self.now
+
+    def _scope_all(self, bus: str) -> bool:
+        return self.net.arbitration.get(bus) == "address_backoff" and self.net.backoff_scope == "all"
+
+    def _backoff_wait(self, bus: str) -> float:
+        """Seconds until this slave may start a request: its slot in the window after a collision
+        (rank x backoff_slots slots), or the window's end if the slot has passed; 0 when free."""
+        at = self._collision_at.get(bus)
+        if at is None or not self._scope_all(bus):
+            return 0.0
+        t = self._timing(bus)
+        slaves = self.net.requesters.get(bus, ())   # spec: rank among the bus's requesting slaves
+        rank = slaves.index(self.address) if self.address in slaves else len(slaves)  # type: ignore[attr-defined]
+        step = self.net.backoff_slots * t.slot_s
+        mine, end = at + rank * step, at + len(slaves) * step
+        now = self.now
+        if now < mine:
+            return mine - now
+        if now < mine + step or now >= end:
+            return 0.0
+        return end - now
 
     def _timing(self, bus: str) -> BusTiming:
         t = self._timings.get(bus)

@@ -63,6 +63,7 @@ def check_documents(nodes_path: Path, messages_path: Path) -> tuple[dict, dict]:
     roles = _lint_nodes(nodes_path, nodes_doc, report)
     nodes_ok = not report.problems  # routes over a broken node table would only repeat its problems
     _lint_messages(messages_path, messages_doc, nodes_doc, roles, report, check_routes=nodes_ok)
+    _lint_request_messages(nodes_path, nodes_doc, messages_doc, report)
     report.raise_if_any()
     return nodes_doc, messages_doc
 
@@ -116,6 +117,23 @@ def _lint_nodes(path: Path, doc: dict, report: Report) -> set[str]:
     return roles
 
 
+def _lint_request_messages(path: Path, doc: dict, messages_doc: dict, report: Report) -> None:
+    """A bus's request message must exist and be sent by its slaves to its master (seed 3.2.2)."""
+    by_name = {m["name"]: m for m in messages_doc["messages"]}
+    master_role = {n["short"]: n["role"] for n in doc["nodes"]}
+    for bus, b in doc["buses"].items():
+        name = b.get("request_message")
+        if name is None:
+            continue
+        m = by_name.get(name)
+        if m is None:
+            report.add(path, doc, ["buses", bus, "request_message"], f"bus {bus}: request_message unknown message '{name}'")
+            continue
+        slave_roles = {n["role"] for n in doc["nodes"] if n["bus"] == bus}
+        if master_role.get(b["master"]) not in m["to"] or not slave_roles & set(m["from"]):
+            report.add(path, doc, ["buses", bus, "request_message"], f"bus {bus}: {name} is not sent by its slaves to {b['master']}")
+
+
 # -- messages -------------------------------------------------------------------
 def _lint_messages(path: Path, doc: dict, nodes_doc: dict, roles: set[str], report: Report, check_routes: bool) -> None:
     _lint_checksum(path, doc, report)
@@ -130,6 +148,11 @@ def _lint_messages(path: Path, doc: dict, nodes_doc: dict, roles: set[str], repo
     seen_op: dict[int, str] = {}
     seen_name: set[str] = set()
     max_payload = doc["frame"]["max_payload"]
+    names = {m["name"] for m in doc["messages"]}
+    for i, m in enumerate(doc["messages"]):
+        if "relayed_as" in m and m["relayed_as"] not in names:
+            report.add(path, doc, ["messages", i, "relayed_as"], f"{m['name']}: relayed_as unknown message '{m['relayed_as']}'")
+
     for i, m in enumerate(doc["messages"]):
         at = ["messages", i]
         name = m["name"]

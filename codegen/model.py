@@ -71,6 +71,7 @@ class Bus:
     arbitration: str
     section: str
     slaves: tuple[str, ...] = ()
+    request_message: str | None = None   # what a slave sends to ask for the line (None: polled bus)
 
     @property
     def char_time_us(self) -> float:
@@ -83,6 +84,11 @@ class Bus:
     @property
     def idle_gap_us(self) -> float:
         return self.idle_gap_chars * self.char_time_us
+
+    @property
+    def frame_gap_us(self) -> float:
+        """Least idle time before any frame may start: the turnaround, and the gap that delimits frames."""
+        return max(self.turnaround_us, self.idle_gap_us)
 
 
 @dataclass(frozen=True)
@@ -224,6 +230,7 @@ class Message:
     receivers: tuple[str, ...]
     doc: str
     fields: tuple[Field, ...]
+    relayed_as: str | None = None   # the MCP delivers this record to its target as that message
 
     @property
     def fixed_size(self) -> int:
@@ -423,7 +430,7 @@ def build(nodes_doc: dict, messages_doc: dict, sources: tuple[Path, ...], digest
                   bits_per_char=b["bits_per_char"], turnaround_us=b["turnaround_us"],
                   idle_gap_chars=b["idle_gap_chars"], response_timeout_ms=b["response_timeout_ms"],
                   id_retries=b["id_retries"], arbitration=b["arbitration"], section=b["section"],
-                  slaves=tuple(n.short for n in nodes if n.bus == name))
+                  slaves=tuple(n.short for n in nodes if n.bus == name), request_message=b.get("request_message"))
         for name, b in nodes_doc["buses"].items()
     }
     post_doc = nodes_doc["post"]
@@ -444,7 +451,7 @@ def build(nodes_doc: dict, messages_doc: dict, sources: tuple[Path, ...], digest
         Message(name=m["name"], seed_name=m.get("seed_name", m["name"]), opcode=m["opcode"], section=m["section"],
                 origin=m.get("origin", "seed"), broadcast=bool(m.get("broadcast", False)),
                 senders=tuple(m["from"]), receivers=tuple(m["to"]), doc=m["doc"],
-                fields=_fields(m.get("fields", []), enums, flags, fdoc["max_payload"]))
+                fields=_fields(m.get("fields", []), enums, flags, fdoc["max_payload"]), relayed_as=m.get("relayed_as"))
         for m in messages_doc["messages"]
     )
     p = nodes_doc["protocol"]

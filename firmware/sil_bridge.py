@@ -271,34 +271,11 @@ def check_sil_nodes(spec: Any, names: list[str]) -> None:
 
 
 def run_scenario(path: str, sil: tuple[str, ...], seed: int | None = None, spec: Any = None):
-    """sim2d.runner.run with the nodes in `sil` run as firmware (until sim2d's CLI has --sil).
-
-    Patches two names of sim2d.sim for the run: behaviour_class (the SIL nodes get a
-    SilNode) and _receiver (a SIL node's UART hears every frame on its bus, also
-    those for other nodes, which sim2d drops before a Python node's receive()).
-    """
-    from unittest import mock
-
-    from sim2d import runner, sim
+    """sim2d.runner.run with the nodes in `sil` run as firmware (what `arachnae sim run --sil` does)."""
+    from sim2d import runner
     spec = spec or runner.load_spec_once()
     check_sil_nodes(spec, list(sil))
-    addresses = {n.address for n in spec.nodes if n.short in sil}
-    python_class, python_receiver = sim.behaviour_class, sim._receiver
-
-    def behaviour_class(role: str):
-        cls = python_class(role)
-
-        def make(address: int, transmit: Any, hw: Any, config: Any) -> Any:
-            return sil_factory()(address, transmit, hw, config) if address in addresses else cls(address, transmit, hw, config)
-        return make
-
-    def receiver(node: Any, hw: Any) -> Any:
-        if isinstance(node, SilNode):
-            return lambda bus, t, data: node.receive(bus, data)
-        return python_receiver(node, hw)
-
-    with mock.patch.object(sim, "behaviour_class", behaviour_class), mock.patch.object(sim, "_receiver", receiver):
-        return runner.run(path, seed, spec=spec)
+    return runner.run(path, seed, spec=spec, replace_nodes={name: sil_factory() for name in sil})
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -15,11 +15,6 @@ from arachnae.errors import UserError
 
 # Fields the checker would read from the spec if they existed (see report).
 MISSING_FIELDS = [
-    "buses.<bus>.request_message: which message opens a slave-initiated session (XMIT_REQ / DATA_RDY)",
-    "arbitration.address_backoff.backoff_slots: slots per rank step (rule text says (rank + 1) slots -> 1)",
-    "messages.<record>.relayed_as: which master message delivers a slave's record (XMIT_RECORD -> DATA, MOVE -> MOVE_RELAYED)",
-    "arbitration.address_backoff.backoff_scope: 'all' (every slave defers after a collision); "
-    "the current 'colliders' reading starves a slave (checker counterexample)",
     "buses.<bus>.max_response_delay_ms: how late a node may answer (for late-ACK exploration)",
 ]
 
@@ -33,10 +28,20 @@ def load(spec_dir: str | None = None):
 
 
 def frame_us(spec, bus: str, message: str) -> float:
-    """Wire time of the longest frame of `message` on `bus`, plus the bus turnaround."""
+    """Wire time of the longest frame of `message` on `bus`, plus the frame gap before it (spec buses)."""
     m = spec.message(message)
     b = spec.buses[bus]
-    return spec.frame_time_us(bus, m.max_size) + b.turnaround_us
+    return spec.frame_time_us(bus, m.max_size) + b.frame_gap_us
+
+
+def response_window_us(spec, bus: str) -> float:
+    """How long a master waits for a reply: seed 3.2.2's timeout, to the reply's first byte when the
+    spec says so (protocol.response_timeout_to), then for the rest of the longest ID_ACK."""
+    b = spec.buses[bus]
+    window = b.response_timeout_ms * 1000.0
+    if spec.protocol.response_timeout_to == "first_byte":
+        window += spec.frame_time_us(bus, spec.message("ID_ACK").max_size)
+    return window
 
 
 def slots(duration_us: float, slot_us: float) -> int:
@@ -67,18 +72,11 @@ class ArbParams:
 
 
 def request_message(spec, bus: str) -> str:
-    """Adapter: the message a slave sends to ask for the bus (spec lacks buses.<bus>.request_message)."""
-    b = spec.buses[bus]
-    roles = {spec.node(s).role for s in b.slaves}
-    master_role = spec.node(b.master).role
-    for name in ("XMIT_REQ", "DATA_RDY"):
-        try:
-            m = spec.message(name)
-        except KeyError:
-            continue
-        if roles & set(m.senders) and master_role in m.receivers:
-            return name
-    raise UserError(f"bus {bus}: no request message (XMIT_REQ or DATA_RDY) its slaves send to {b.master}")
+    """The message a slave sends to ask for the bus (spec buses.<bus>.request_message)."""
+    name = spec.buses[bus].request_message
+    if name is None:
+        raise UserError(f"bus {bus}: no request_message in the spec, so its slaves cannot ask for the line")
+    return name
 
 
 def record_route(spec, bus: str, slave) -> tuple[list[str], list[str], str]:
@@ -104,8 +102,7 @@ def record_route(spec, bus: str, slave) -> tuple[list[str], list[str], str]:
         raise UserError(f"bus {bus}: no record message for {slave.short}")
     fetch.append(record.name)
     if record.name != "XMIT_DATA" and record.seed_name != "XMIT_DATA":
-        relayed = next((m for m in spec.messages if m.seed_name == record.name and master.role in m.senders
-                        and m is not record), None) or spec.message("DATA")
+        relayed = spec.message(record.relayed_as or "DATA")   # spec messages.<record>.relayed_as
         dest = next((n for n in spec.nodes if n.bus == bus and n.role in relayed.receivers), None)
         if dest is not None:
             relay.append(relayed.name)
@@ -170,7 +167,7 @@ def identification(spec, bus: str) -> IdParams:
     tick = b.char_time_us
     req = slots(frame_us(spec, bus, "ID_REQ"), tick)
     ack = slots(frame_us(spec, bus, "ID_ACK"), tick)
-    timeout = slots(b.response_timeout_ms * 1000.0, tick)   # seed 3.2.2: 10 ms
+    timeout = slots(response_window_us(spec, bus), tick)    # seed 3.2.2: 10 ms (to the first byte)
     return IdParams(bus=bus, master=b.master, slaves=list(b.slaves), tick_us=tick, req_ticks=req, ack_ticks=ack,
                     timeout_ticks=timeout, retries=b.id_retries,
                     max_delay_ticks=max_response_delay_ticks(spec, bus, timeout, req))

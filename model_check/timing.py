@@ -1,7 +1,7 @@
 """Worst-case timing from the spec: POST, whisker-to-STOP latency, a full ultrasonic scan.
 
 Frame times come from the spec (frame size at the bus's baud rate plus
-turnaround); contention waits on the slave-initiated buses are the response
+the frame gap); contention waits on the slave-initiated buses are the response
 bounds K our checker proves for the arbitration model, so the figures hold
 for every interleaving. Node processing time is not in the spec and counts as
 zero: every figure here is a lower bound on the real worst case in that sense.
@@ -9,7 +9,7 @@ zero: every figure here is a lower bound on the real worst case in that sense.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from model_check import spec_adapter as sa
 from model_check.engine import explore
@@ -45,7 +45,7 @@ def post_duration(spec) -> Figure:
             continue
         node = spec.node(n.short)
         bus = spec.buses[node.bus]
-        per = (bus.id_retries + 1) * (sa.frame_us(spec, bus.name, "ID_REQ") + bus.response_timeout_ms * 1000)
+        per = (bus.id_retries + 1) * (sa.frame_us(spec, bus.name, "ID_REQ") + sa.response_window_us(spec, bus.name))
         total += per
         if n.masters:     # the sub-master's report to its own master
             total += sa.frame_us(spec, bus.name, "POST_QUERY") + sa.frame_us(spec, bus.name, "POST_REPORT")
@@ -54,7 +54,15 @@ def post_duration(spec) -> Figure:
     return Figure("POST worst case", total / 1000, None, "6.3", parts, "no bound in the seed")
 
 
-def stop_latency(spec, scope: str | None) -> Figure:
+STANDARD_BAUDS = (4800, 9600, 19200, 38400, 57600, 115200)
+
+
+def _with_baud(spec, **bauds: int):
+    """A copy of the spec with some buses at another baud rate (to find the parameter that meets a bound)."""
+    return replace(spec, buses={**spec.buses, **{b: replace(spec.buses[b], baud=v) for b, v in bauds.items()}})
+
+
+def stop_latency(spec, scope: str | None, suggest: bool = True) -> Figure:
     """seed 5.2: reaction to a tactile stimulus within 1 s; path TPSC-SPU-MCP-NP3-MCP-MMC-LCPs."""
     parts, total = [], 0.0
     sensor, s_slot = _arb_bound(spec, "sensor", scope)
@@ -75,7 +83,22 @@ def stop_latency(spec, scope: str | None) -> Figure:
         parts.append(f"{name}: {us / 1000:.1f} ms")
     ms = total / 1000
     verdict = "meets" if ms <= 1000 else f"FAILS: {ms:.0f} ms > 1000 ms"
+    if ms > 1000 and suggest:
+        parts.append(_stop_latency_fix(spec, scope))
     return Figure("whisker contact to STOP at the legs", ms, 1000.0, "5.2", parts, verdict)
+
+
+def _stop_latency_fix(spec, scope: str | None) -> str:
+    """The smallest standard baud rate of the sensor bus (then of both relaying buses) meeting 1 s."""
+    for baud in (b for b in STANDARD_BAUDS if b > spec.buses["sensor"].baud):
+        f = stop_latency(_with_baud(spec, sensor=baud), scope, suggest=False)
+        if f.ms is not None and f.ms <= 1000:
+            return f"would meet 1 s with the sensor bus at {baud} baud ({f.ms:.0f} ms)"
+    for baud in (b for b in STANDARD_BAUDS if b > spec.buses["first"].baud):
+        f = stop_latency(_with_baud(spec, sensor=baud, first=baud), scope, suggest=False)
+        if f.ms is not None and f.ms <= 1000:
+            return f"would meet 1 s with the sensor and first-level buses both at {baud} baud ({f.ms:.0f} ms)"
+    return "no standard baud rate of the sensor and first-level buses meets 1 s"
 
 
 def scan_duration(spec, measurements: int = 3, step_deg: int = 1, range_m: float = 10.0) -> Figure:
@@ -101,14 +124,16 @@ def scan_duration(spec, measurements: int = 3, step_deg: int = 1, range_m: float
 
 
 def id_timeout_check(spec) -> list[str]:
-    """seed 3.2.2: an ID_ACK must fit in the 10 ms window, or no node can answer the retry in time."""
+    """seed 3.2.2: a reply must be able to start within the timeout after the frame gap that delimits frames."""
     out = []
+    first_byte = spec.protocol.response_timeout_to == "first_byte"
     for b in spec.buses.values():
-        ack = sa.frame_us(spec, b.name, "ID_ACK") / 1000
-        if ack > b.response_timeout_ms:
-            out.append(f"bus {b.name}: ID_ACK takes {ack:.1f} ms on the wire at {b.baud} baud, longer than the "
-                       f"{b.response_timeout_ms:g} ms timeout; a timeout of at least {math.ceil(ack)} ms "
-                       f"(or {math.ceil(7 * 10 * 1000 / b.response_timeout_ms)} baud) would meet it")
+        ack_ms = spec.frame_time_us(b.name, spec.message("ID_ACK").max_size) / 1000
+        earliest_ms = b.frame_gap_us / 1000 + (0 if first_byte else ack_ms)
+        if earliest_ms > b.response_timeout_ms:
+            out.append(f"bus {b.name}: a reply cannot {'start' if first_byte else 'end'} before {earliest_ms:.1f} ms at "
+                       f"{b.baud} baud (frame gap {b.frame_gap_us / 1000:.1f} ms), later than the "
+                       f"{b.response_timeout_ms:g} ms timeout; a timeout of at least {math.ceil(earliest_ms)} ms would meet it")
     return out
 
 

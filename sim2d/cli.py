@@ -20,6 +20,8 @@ def register(sub: Any) -> None:
     run.add_argument("--seed", type=int, help="override the scenario's seed")
     run.add_argument("--out", help="output folder (default sim-out/NAME-seedN)")
     run.add_argument("--gif", action="store_true", help="also write an animation run.gif")
+    run.add_argument("--sil", action="append", default=[], metavar="NODE",
+                     help="run NODE (e.g. TPSC) as AVR firmware in simavr (software in the loop; `make firmware` first)")
     run.set_defaults(func=cmd_run)
 
     batch = ssub.add_parser("batch", help="run scenarios x seeds in parallel")
@@ -55,7 +57,13 @@ def cmd_run(args: argparse.Namespace) -> int:
     from sim2d import runner
 
     _check_file(args.scenario)
-    outcome = runner.run(args.scenario, args.seed, gif=args.gif)
+    replace_nodes = None
+    if args.sil:
+        from firmware.sil_bridge import check_sil_nodes, sil_factory
+
+        check_sil_nodes(runner.load_spec_once(), args.sil)
+        replace_nodes = {name: sil_factory() for name in args.sil}
+    outcome = runner.run(args.scenario, args.seed, gif=args.gif, replace_nodes=replace_nodes)
     out = runner.write_outputs(outcome, args.out or runner.default_out(outcome), gif=args.gif)
     m = outcome.result.metrics
     print(f"{outcome.scenario.name} seed {outcome.scenario.seed}: POST {m['post']['verdict']}, "

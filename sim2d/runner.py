@@ -32,12 +32,13 @@ def load_spec_once() -> Any:
     return load_spec()
 
 
-def run(path: str, seed: int | None = None, spec: Any = None, gif: bool = False) -> Outcome:
+def run(path: str, seed: int | None = None, spec: Any = None, gif: bool = False,
+        replace_nodes: dict[str, Any] | None = None) -> Outcome:
     spec = spec or load_spec_once()
     sc = load_scenario(path, spec)
     if seed is not None:
         sc = sc.with_seed(seed)
-    sim = Simulation(sc, spec, keep_frames_every=GIF_FRAME_S if gif else None)
+    sim = Simulation(sc, spec, keep_frames_every=GIF_FRAME_S if gif else None, replace_nodes=replace_nodes)
     result = sim.run()
     return Outcome(sc, result, check_expectations(sc, result.metrics))
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import hashlib
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Callable
 
 from arachnae_proto import CodecError
 from arachnae_proto.frame import check, parse
@@ -106,9 +106,16 @@ def _echo(node: Runtime, hw: NodeHardware) -> Any:
     return echo
 
 
+NodeFactory = Callable[..., Any]   # (address, transmit, hw, config) -> a node that takes receive(bus, data)
+
+
 class Simulation:
-    def __init__(self, scenario: Scenario, spec: Any, params: RobotParams = DEFAULT, keep_frames_every: float | None = None):
+    def __init__(self, scenario: Scenario, spec: Any, params: RobotParams = DEFAULT, keep_frames_every: float | None = None,
+                 replace_nodes: dict[str, NodeFactory] | None = None):
+        """`replace_nodes` runs some nodes as something else than their Python behaviour, e.g. firmware
+        in simavr (`--sil`); such a node's UART hears every frame on its buses."""
         self.scenario, self.spec, self.params = scenario, spec, params
+        replace_nodes = replace_nodes or {}
         self.sched = Scheduler()
         self.world = World(scenario)
         self.robot = Robot(params, self.world, scenario.start)
@@ -116,7 +123,8 @@ class Simulation:
         self.frames: list[FrameRecord] = []
         self.buses: dict[str, Bus] = {}
         for name, b in spec.buses.items():
-            self.buses[name] = Bus(name, self.sched, b.baud, b.bits_per_char, b.turnaround_us * 1e-6,
+            # spec buses: no frame starts before the line was idle for the frame gap (turnaround, idle gap)
+            self.buses[name] = Bus(name, self.sched, b.baud, b.bits_per_char, b.frame_gap_us * 1e-6,
                                    stream(scenario.seed, f"bus:{name}"), self._trace)
         self.config = Config(NetConfig.from_spec(spec), geometry=params, task=scenario.task)
         self.nodes: dict[str, Runtime] = {}
@@ -143,11 +151,17 @@ class Simulation:
             if n.short in absent:
                 continue
             hw = NodeHardware(self, n)
-            proc = behaviour_class(n.role)(n.address, hw.transmit, hw, self.config)
+            factory = replace_nodes.get(n.short)
+            if factory is None:
+                proc = behaviour_class(n.role)(n.address, hw.transmit, hw, self.config)
+                receive = _receiver(proc, hw)
+            else:
+                proc = factory(n.address, hw.transmit, hw, self.config)
+                receive = (lambda p: lambda bus, t, data: p.receive(bus, data))(proc)
             self.nodes[n.short], self.hardware[n.short] = proc, hw
             for bus in (n.bus, n.masters):
                 if bus is not None:
-                    hw.ports[bus] = self.buses[bus].attach(n.short, _receiver(proc, hw), _echo(proc, hw))
+                    hw.ports[bus] = self.buses[bus].attach(n.short, receive, _echo(proc, hw))
         # a JAC that is absent, or whose LCP is, never gets a set-point: its servo is limp (CHOICE)
         for n in spec.role_nodes("JAC"):
             lcp = next(m for m in spec.role_nodes("LCP") if m.leg == n.leg)

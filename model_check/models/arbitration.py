@@ -1,7 +1,7 @@
 """Bus arbitration (seed 3.2.2 "Message Scheduling") as a slotted guarded-command model.
 
 Time is discrete: one tick is one slot, the time of one request frame plus the
-bus turnaround (spec arbitration.slot: request_frame). Slaves whose record is
+frame gap (spec arbitration.slot: request_frame). Slaves whose record is
 pending and who see the bus idle start their request at a slot boundary; two
 or more starts in the same slot corrupt every frame (each slave reads a bad
 echo). The master serves the first request that got through: it fetches the
@@ -130,4 +130,4 @@ def build(p: ArbParams, variant: str, slaves: int | None = None) -> Model:
     label = f"{variant}/{p.scope}" if variant == "spec" else variant
     return Model(name=f"arbitration[{p.bus},{label},{n} slaves]", vars=vs, rules=rules, invariants=invs,
                  responses=resp, defs=defs, tick_us=p.slot_us, participants=[m] + [s.short for s in sl],
-                 notes=[f"seed {p.rule_section}; slot = {p.request} + turnaround = {p.slot_us:.0f} us"])
+                 notes=[f"seed {p.rule_section}; slot = {p.request} + frame gap = {p.slot_us:.0f} us"])
