@@ -8,8 +8,6 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[2]
 FIRMWARE = REPO / "firmware"
-if str(REPO) not in sys.path:
-    sys.path.insert(0, str(REPO))
 
 
 def make(*targets: str, **variables: str) -> subprocess.CompletedProcess:
