@@ -3,9 +3,17 @@ from __future__ import annotations
 
 from typing import Any
 
-from PIL import Image, ImageDraw
+from functools import lru_cache
+
+from PIL import Image, ImageDraw, ImageFont
 
 from sim2d.geometry import to_world
+
+
+@lru_cache(maxsize=1)
+def _font() -> ImageFont.ImageFont:
+    """Pillow's bundled scalable font: the bitmap fallback drops the spaces of our captions."""
+    return ImageFont.load_default(size=12)
 
 MAX_PX = 900
 PATH, SONAR, IR, WHISKER, ROBOT = (0, 120, 255), (160, 0, 160), (255, 120, 0), (220, 0, 0), (30, 90, 200)
@@ -64,7 +72,7 @@ def _legend(draw: ImageDraw.ImageDraw, v: _View) -> None:
     for colour, label in ((PATH, "trajectory"), (ROBOT, "final pose"), (SONAR, "sonar returns"),
                           (IR, "IR rays / echoes"), (WHISKER, "whisker contacts")):
         draw.rectangle([x, y, x + 10, y + 8], fill=colour)
-        draw.text((x + 14, y - 2), label, fill=(0, 0, 0))
+        draw.text((x + 14, y - 2), font=_font(), text=label, fill=(0, 0, 0))
         x += 24 + 7 * len(label)
 
 
@@ -95,7 +103,7 @@ def render_png(result: Any, path: str) -> None:
         d.ellipse([x - 4, y - 4, x + 4, y + 4], outline=WHISKER, width=2)
     _legend(d, v)
     m = result.metrics
-    d.text((24, 4), f"{sc.name} seed {sc.seed}  POST {m['post']['verdict']}  walked {m['distance_walked_m']:.2f} m  "
+    d.text((24, 4), font=_font(), text=f"{sc.name} seed {sc.seed}  POST {m['post']['verdict']}  walked {m['distance_walked_m']:.2f} m  "
                     f"collisions {m['collisions']}", fill=(0, 0, 0))
     img.save(path)
 
@@ -114,7 +122,7 @@ def render_gif(result: Any, path: str) -> None:
         if len(trail) > 1:
             d.line(trail, fill=(0, 120, 255), width=2)
         _robot(d, v, pose, feet, robot.p)
-        d.text((24, 4), f"t = {t:5.1f} s", fill=(0, 0, 0))
+        d.text((24, 4), font=_font(), text=f"t = {t:5.1f} s", fill=(0, 0, 0))
         frames.append(img.convert("P", palette=Image.ADAPTIVE, colors=64))
     if frames:
         frames[0].save(path, save_all=True, append_images=frames[1:], duration=100, loop=0, optimize=True)
