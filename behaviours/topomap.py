@@ -27,9 +27,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterable, Sequence
 
+from arachnae_proto.messages import XmitDataUsrc
+
 UNKNOWN, FREE, OCCUPIED = 0, 1, 2
 
-USRC_MAX_RANGE_M = 10.0      # seed 3.2.11: 0..255 = 0..10 m
+_DISTANCE = next(f for f in XmitDataUsrc.FIELDS if f.name == "distance")
+USRC_MAX_RANGE_M = _DISTANCE.conv.to_phys(_DISTANCE.conv.hi)   # seed 3.2.11: 0..255 = 0..10 m, from the spec
 USRC_MIN_RANGE_M = 0.3       # seed 5.2: the scanner is used from 30 cm to about 10 m
 
 
