@@ -49,7 +49,7 @@ class MCP(PostMaster, Runtime, McpSkeleton):
         if isinstance(msg, M.Move):
             self.relay_move(src, msg.mov_cmd, msg.param, 1 + self.net.protocol.move_retries)
         elif isinstance(msg, M.XmitRecord) and msg.target == ADDRESS_OF["NP3"]:
-            self.request(msg.target, M.Data(address=msg.source, value=msg.value))
+            self.request(msg.target, M.Data(address=msg.source, kind=msg.kind, channel=msg.channel, value=msg.value))
         self._served()
 
     def relay_move(self, src: int, mov_cmd: int, param: int, attempts: int) -> None:

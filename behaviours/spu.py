@@ -76,10 +76,10 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
         if not self.outbox:
             if self.last_record is not None:   # a repeated grant: the record did not get through
                 source, value = self.last_record
-                self.send(src, M.XmitRecord(target=np3, source=source, value=value))
+                self.send(src, M.XmitRecord(target=np3, source=source, kind=0, channel=0, value=value))
             return
         source, value = self.outbox.pop(0)
         self.last_record = (source, value)
-        self.send(src, M.XmitRecord(target=np3, source=source, value=value))
+        self.send(src, M.XmitRecord(target=np3, source=source, kind=0, channel=0, value=value))
         if self.outbox:
             self.slave_send(src, M.XmitReq())

@@ -27,6 +27,36 @@ def reaction_latencies(stimuli: list[tuple[float, str]], moves: list[tuple[float
     return out
 
 
+def note_counts(notes: list[tuple[float, str, str, dict[str, Any]]]) -> dict[str, dict[str, Any]]:
+    """Per debug-port event: how often, first and last time (behaviours add events without touching sim2d)."""
+    out: dict[str, dict[str, Any]] = {}
+    for t, _node, event, _data in notes:
+        e = out.setdefault(event, {"count": 0, "first_s": round(t, 6), "last_s": round(t, 6)})
+        e["count"] += 1
+        e["last_s"] = round(t, 6)
+    return dict(sorted(out.items()))
+
+
+def node_metrics(nodes: dict[str, Any], now: float) -> dict[str, Any]:
+    """What each node reports about itself on its debug port at the end (`debug_metrics()`, optional)."""
+    out = {}
+    for short, node in nodes.items():
+        fn = getattr(node, "debug_metrics", None)
+        if fn is not None and getattr(node.hw, "alive", True):
+            out[short] = fn()
+    return out
+
+
+def lookup(metrics: dict[str, Any], path: str) -> Any:
+    """A metric by dotted path ('notes.escape.count'); None when absent."""
+    cur: Any = metrics
+    for part in path.split("."):
+        if not isinstance(cur, dict) or part not in cur:
+            return None
+        cur = cur[part]
+    return cur
+
+
 def build_metrics(sim: "Simulation") -> dict[str, Any]:
     from sim2d.sim import trace_hash
     dur = sim.scenario.duration
@@ -76,6 +106,8 @@ def build_metrics(sim: "Simulation") -> dict[str, Any]:
         "frame_loss": sum(b["lost"] for b in buses.values()),
         "frames_corrupted": sum(b["corrupted"] for b in buses.values()),
         "battery_v": round(sim.robot.battery_voltage(), 3),
+        "notes": note_counts(sim.notes),
+        "nodes": node_metrics(sim.nodes, dur),
         "trace_hash": trace_hash(sim.frames, sim.poses),
     }
 
@@ -109,4 +141,14 @@ def check_expectations(scenario: Any, m: dict[str, Any]) -> list[tuple[str, bool
     if e.stay_out is not None:
         t = m["entered_forbidden_s"]
         out.append(("stay_out", t is None, "never entered the region" if t is None else f"entered the region at {t} s"))
+    for path, bounds in (e.metrics or {}).items():
+        v = lookup(m, path)
+        for op, limit in bounds.items():
+            if op == "min":
+                ok = isinstance(v, (int, float)) and v >= limit
+            elif op == "max":
+                ok = isinstance(v, (int, float)) and v <= limit
+            else:
+                ok = v == limit
+            out.append((f"{path} {op}", ok, f"{path} = {v}, {op} {limit}"))
     return out

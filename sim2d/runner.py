@@ -60,6 +60,10 @@ def write_outputs(outcome: Outcome, out_dir: str | Path, gif: bool = False) -> P
         metrics["expectations"] = [{"name": n, "passed": ok, "detail": d} for n, ok, d in outcome.expectations]
         (tmp / "metrics.json").write_text(json.dumps(metrics, indent=2) + "\n")
         render_png(r, str(tmp / "run.png"))
+        for node in r.nodes.values():         # debug-port dumps a node offers (e.g. the NP3's map)
+            artifacts = getattr(node, "write_artifacts", None)
+            if artifacts is not None:
+                artifacts(tmp)
         if gif:
             render_gif(r, str(tmp / "run.gif"))
         os.chmod(tmp, 0o755)

@@ -15,7 +15,7 @@ from typing import Any
 import yaml
 
 from arachnae.errors import UserError, located
-from sim2d.schema import Bool, Key, List, Map, Num, Point, Polygon, Src, Str, fail
+from sim2d.schema import Bool, Dict, Key, List, Map, Num, Point, Polygon, Scalar, Src, Str, fail
 
 TASKS = ("forward", "wall_follow", "seek_light", "avoid_light", "explore", "idle")  # SPEC-NOTES decision 8
 VERDICTS = ("OPERATIONAL", "DEGRADED", "HALTED")                                  # SPEC-NOTES decision 3
@@ -78,6 +78,7 @@ class Expectations:
     min_distance: float | None = None
     max_reaction: float | None = None   # seed 5.2: stimulus -> reaction within this many seconds
     stay_out: tuple[tuple[float, float], ...] | None = None           # the body centre never enters
+    metrics: dict[str, dict[str, Any]] | None = None                  # dotted metric path -> {min, max, eq}
 
 
 @dataclass(frozen=True)
@@ -164,6 +165,9 @@ def _schemas(spec: Any) -> dict[str, Any]:
             "min_distance": Key(Num(0.0)),
             "max_reaction": Key(Num(positive=True)),
             "stay_out": Key(Polygon()),
+            "metrics": Key(Dict(Map({"min": Key(Num()), "max": Key(Num()), "eq": Key(Scalar())},
+                                    check=lambda d: None if any(v is not None for v in d.values())
+                                    else "give min, max or eq"))),
         }),
     }
 
@@ -279,5 +283,7 @@ def _build(v: dict[str, Any], shown: str) -> Scenario:
             reach=(exp["reach"]["region"], exp["reach"]["within"]) if exp.get("reach") else None,
             min_clearance=exp.get("min_clearance"), never_moves=bool(exp.get("never_moves")),
             min_distance=exp.get("min_distance"), max_reaction=exp.get("max_reaction"), stay_out=exp.get("stay_out"),
+            metrics={k: {op: b for op, b in v.items() if b is not None} for k, v in (exp.get("metrics") or {}).items()}
+            or None,
         ),
     )

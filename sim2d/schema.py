@@ -103,6 +103,25 @@ class List(Schema):
         return [self.item(src, n, f"{what}[{i}]") for i, n in enumerate(node.value)]
 
 
+class Scalar(Schema):
+    """Any single value (a number, a string, true/false)."""
+
+    def __call__(self, src: Src, node: yaml.Node, what: str) -> Any:
+        return _scalar(src, node, what)
+
+
+class Dict(Schema):
+    """A mapping from free-form string keys to values of one schema."""
+
+    def __init__(self, value: Schema):
+        self.value = value
+
+    def __call__(self, src: Src, node: yaml.Node, what: str) -> dict:
+        if not isinstance(node, yaml.MappingNode):
+            raise fail(src, node, f"{what}: expected a mapping")
+        return {str(k.value): self.value(src, v, f"{what}.{k.value}") for k, v in node.value}
+
+
 class Point(Schema):
     def __call__(self, src: Src, node: yaml.Node, what: str) -> tuple[float, float]:
         if not isinstance(node, yaml.SequenceNode) or len(node.value) != 2:

@@ -55,6 +55,7 @@ class Result:
     world: World
     robot: Robot
     frames_png: list = field(default_factory=list)
+    nodes: dict = field(default_factory=dict)      # short name -> node (for its debug-port artifacts)
 
 
 class _Intact:
@@ -136,6 +137,7 @@ class Simulation:
         self.stimuli: list[tuple[float, str]] = []
         self.escapes: list[tuple[float, float]] = []
         self.events: list[tuple[float, str, int]] = []
+        self.notes: list[tuple[float, str, str, dict[str, Any]]] = []   # every debug-port note: t, node, event, data
         self.poses: list[tuple[float, float, float, float]] = []
         self.distance = 0.0
         self.min_clearance = math.inf
@@ -175,6 +177,7 @@ class Simulation:
     def on_note(self, node: Any, event: str, data: dict[str, Any]) -> None:
         """A node's debug-port telemetry (behaviours.hardware.Hardware.note) into the metrics."""
         t = self.sched.now
+        self.notes.append((t, node.short, event, data))
         if event == "post_verdict":
             self.verdict, self.verdict_time = data["verdict"], t
         elif event == "post_report":
@@ -268,7 +271,7 @@ class Simulation:
         from sim2d.metrics import build_metrics
         metrics = build_metrics(self)
         return Result(self.scenario, self.verdict, self.frames, self.poses, metrics, metrics["trace_hash"],
-                      self.sensors, self.world, self.robot, self.snapshots)
+                      self.sensors, self.world, self.robot, self.snapshots, self.nodes)
 
 
 def trace_lines(frames: list[TraceEntry]) -> list[str]:

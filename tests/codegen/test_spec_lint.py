@@ -48,7 +48,7 @@ CASES = [
     ("unknown_enum", M, "{name: mov_cmd, type: enum, enum: MOV_CMD, bits: 4}\n      - {name: param, type: uint, bits: 4, range: [0, 0], doc",
      "{name: mov_cmd, type: enum, enum: MOVE_CMD, bits: 4}\n      - {name: param, type: uint, bits: 4, range: [0, 0], doc",
      "enum: MOVE_CMD", "MOVE.mov_cmd: unknown enum 'MOVE_CMD'"),
-    ("enum_wider_than_field", M, "JAC_OUT_OF_ORDER: 3, LCP_OUT_OF_ORDER: 4}", "JAC_OUT_OF_ORDER: 3, LCP_OUT_OF_ORDER: 4, OTHER: 16}",
+    ("enum_wider_than_field", M, "LCP_OUT_OF_ORDER: 4, NO_GROUND: 5}", "LCP_OUT_OF_ORDER: 4, NO_GROUND: 5, OTHER: 16}",
      "{name: error, type: enum, enum: MMC_ERROR, bits: 4}", "STATUS_ACK_MMC.error: enum MMC_ERROR has value 16, wider than 4 bits"),
     ("unknown_role", M, "from: [NP3, UIC_RCP]", "from: [NP3, UIC_RPC]", None, "MOVE: unknown node role 'UIC_RPC' in `from`"),
     ("not_on_one_bus", M, "    from: [USRC]\n    to: [SPU]", "    from: [USRC]\n    to: [MCP]", None,
