@@ -1,10 +1,21 @@
 """The MMC's gait generator (seed 3.2.3/3.2.4): foot targets in the body frame.
 
 A gait is a duty factor plus a phase offset per leg (tripod, ripple, wave:
-seed 3.2.3 Mov_Cmd 7..9). Each leg alternates stance (foot on the ground,
-moving against the body's motion) and swing (foot lifted, moving forward).
-A new command takes effect at a leg's next stance/swing boundary, so a
-foot never jumps while it carries the body.
+seed 3.2.3 Mov_Cmd 7..9). Every swing lasts one tripod half cycle; a leg
+lifts off when the gait's phase reaches its offset + duty and lands where
+the next stance starts, half a stroke ahead of its neutral point. Stance
+feet all move with one rigid body motion (the direction's velocity), so
+they never shear against each other; a stance foot about to leave its
+workspace pauses the body until that leg has stepped (safety net).
+
+Changing the gait or the direction (seed 3.2.3: a gait change keeps the
+direction) never makes a foot jump: stance feet carry on from where they
+are in the new direction at once, swinging feet re-aim their touchdown,
+no new swing starts until every foot is down, and then the new gait's
+phase is chosen to fit where the feet are (`_rephase`). With a leg lost
+(seed 6.3 allows one) the remaining five walk a wave over five legs with a
+shorter stroke, the two feet on the lost leg's side spread to straddle it,
+so that four feet on the ground always keep the body statically stable.
 """
 from __future__ import annotations
 
@@ -13,13 +24,17 @@ from dataclasses import dataclass
 
 from arachnae_proto.enums import MovCmd
 
+from behaviours import tuning as T
 from behaviours.geometry import RobotGeometry
+from behaviours.kinematics import swing_point
 
 # Mov_Cmd values of seed 3.2.3, as plain ints (the generated enum is the source; ints are faster).
 STOP, FORWARD, BACKWARD = int(MovCmd.STOP), int(MovCmd.FORWARD), int(MovCmd.BACKWARD)
 TURN_RIGHT, TURN_LEFT = int(MovCmd.TURN_RIGHT), int(MovCmd.TURN_LEFT)
 SIDESTEP_RIGHT, SIDESTEP_LEFT = int(MovCmd.SIDESTEP_RIGHT), int(MovCmd.SIDESTEP_LEFT)
 TRIPOD, RIPPLE, WAVE = int(MovCmd.TRIPOD), int(MovCmd.RIPPLE), int(MovCmd.WAVE)
+GAITS = (TRIPOD, RIPPLE, WAVE)
+FIVE_LEGGED = 0                      # gait id of the five-legged wave (not a Mov_Cmd)
 
 # (vx, vy, w) per direction: body-frame unit motion, x forward, y left, w counter-clockwise.
 MOTION = {
@@ -28,111 +43,258 @@ MOTION = {
     SIDESTEP_RIGHT: (0.0, -1.0, 0.0), SIDESTEP_LEFT: (0.0, 1.0, 0.0),
 }
 
+WAVE_ORDER = (3, 2, 1, 6, 5, 4)      # CHOICE: metachronal, rear to front, left side then right side
 
-def _offsets(gait: int) -> tuple[float, dict[int, float]]:
-    """Duty factor and per-leg phase offsets. CHOICE: wave/ripple orders follow the usual hexapod patterns."""
+
+def pattern(gait: int, legs: tuple[int, ...]) -> tuple[float, dict[int, float]]:
+    """Duty factor and per-leg phase offsets (phase at which the leg's stance begins).
+
+    CHOICE: tripod 1-3-5 / 2-4-6; ripple: each side a rear-to-front wave, the sides half a cycle
+    apart (two feet up at a time); wave: one foot up at a time in WAVE_ORDER. Five legs: a wave over
+    the remaining legs in WAVE_ORDER (one foot up, four down).
+    """
     if gait == TRIPOD:
         return 0.5, {1: 0.0, 3: 0.0, 5: 0.0, 2: 0.5, 4: 0.5, 6: 0.5}
-    if gait == RIPPLE:
-        return 2 / 3, {1: 0.0, 5: 1 / 6, 3: 1 / 3, 4: 1 / 2, 2: 2 / 3, 6: 5 / 6}
-    return 5 / 6, {1: 0.0, 2: 1 / 6, 3: 2 / 6, 4: 3 / 6, 5: 4 / 6, 6: 5 / 6}
+    if gait == RIPPLE:     # the feet up together are never both front or both rear legs
+        return 2 / 3, {3: 0.0, 4: 1 / 6, 2: 1 / 3, 6: 1 / 2, 1: 2 / 3, 5: 5 / 6}
+    order = [leg for leg in WAVE_ORDER if leg in legs]
+    n = len(order)
+    return 1 - 1 / n, {leg: i / n for i, leg in enumerate(order)}
 
 
 @dataclass
 class LegPlan:
     swing: bool = False
-    start: tuple[float, float] = (0.0, 0.0)
-    end: tuple[float, float] = (0.0, 0.0)
+    pos: tuple[float, float] = (0.0, 0.0)    # stance: the foot now; swing: where it lifted off
+    c: float = 0.0                           # stance: stroke coordinate, +1/2 front .. -1/2 back
+    t0: float = 0.0                          # swing start (gait clock)
+    dur: float = 0.0                         # swing duration (gait clock)
+    end: tuple[float, float] = (0.0, 0.0)    # swing touchdown point
     lift: float = 0.0
-    active: bool = True      # False: the leg stays put in stance (STOP reached neutral)
-    s0: float = 0.0          # segment progress when the plan was last changed
+    next_lift: float = 0.0                   # total gait phase of the next lift-off
+    z0: float = 0.0                          # height at swing start
+    cmd: int = STOP                          # the direction the swing's touchdown point was aimed for
 
 
 class Gait:
-    """The MMC's gait generator: advance(dt), then target(leg) gives (x, y, z) in the body frame."""
+    """The MMC's gait generator: set_command(), advance(dt), then target(leg) gives (x, y, z) in the body frame."""
 
     def __init__(self, p: RobotGeometry, legs: tuple[int, ...] | None = None):
         self.p = p
-        self.legs = legs or p.legs
+        self.legs = tuple(legs or p.legs)            # legs in the gait (a lost leg is dropped)
+        self.lost: set[int] = set()
         self.command = STOP
-        self.gait = TRIPOD
-        self.phase = 0.0
-        self.lift_boost: dict[int, float] = {}
-        self.plans = {leg: LegPlan(start=p.neutral_foot(leg), end=p.neutral_foot(leg), active=False) for leg in self.legs}
-        self._set_gait(TRIPOD)
+        self.gait = TRIPOD                           # the Mov_Cmd gait (what STATUS_ACK reports)
+        self.running = TRIPOD                        # the pattern walking now (FIVE_LEGGED after a loss)
+        self.t = 0.0                                 # gait clock, s
+        self.phase = 0.0                             # total gait phase (cycles)
+        self.scale = 1.0                             # gait clock speed (slowed on servo over-temperature)
+        self.pending = True                          # re-phase when every foot is down
+        self.paused = False
+        self.gait_switches = 0
+        self.pause_s = 0.0
+        self.dt = 0.02                               # the last clock step (gait seconds)
+        self.swing_lift = p.lift                     # how high the next swings lift (raised near an obstacle)
+        self.plans = {leg: LegPlan(pos=p.neutral_foot(leg)) for leg in p.legs}
+        self._set_pattern(TRIPOD)
 
-    def _set_gait(self, gait: int) -> None:
-        self.gait = gait
-        self.duty, self.offset = _offsets(gait)
-        self.cycle = self.p.half_cycle / (1 - self.duty)   # every swing lasts one tripod half cycle
+    # --- pattern and geometry ------------------------------------------------------------
+    def _set_pattern(self, gait: int) -> None:
+        self.running = gait
+        self.duty, self.offset = pattern(gait, self.legs)
+        self.t_swing = self.p.half_cycle                    # every swing lasts one tripod half cycle
+        self.cycle = self.t_swing / (1 - self.duty)
+        self.t_stance = self.duty * self.cycle
+        self.stroke = self.p.stroke * (T.GAIT_FIVE_LEG_STROKE if self.lost else 1.0)
+        self.max_up = round(len(self.legs) * (1 - self.duty))
 
+    def neutral(self, leg: int) -> tuple[float, float]:
+        """The leg's neutral foot point; with a leg lost, the two feet left on its side straddle the gap."""
+        nx, ny = self.p.neutral_foot(leg)
+        if self.lost:
+            side = self.p.side(leg)
+            mates = sorted((lg for lg in self.legs if self.p.side(lg) == side), key=lambda lg: -self.p.hip(lg)[0])
+            if len(mates) == 2 and any(self.p.side(lost) == side for lost in self.lost):
+                spread = self.p.hip_x[0] * T.GAIT_FIVE_LEG_SPREAD
+                nx = spread if leg == mates[0] else -spread
+        return nx, ny
+
+    def path(self, leg: int, c: float, cmd: int | None = None) -> tuple[float, float]:
+        """Stance path: where the foot is at stroke coordinate c (+1/2 touchdown .. -1/2 lift-off)."""
+        vx, vy, w = MOTION[self.command if cmd is None else cmd]
+        nx, ny = self.neutral(leg)
+        a = c * self.p.turn_stroke_rad * w
+        ca, sa = math.cos(a), math.sin(a)
+        return (ca * nx - sa * ny + c * self.stroke * vx, sa * nx + ca * ny + c * self.stroke * vy)
+
+    def _project(self, leg: int, pos: tuple[float, float]) -> float:
+        """Stroke coordinate of the path point nearest to pos (after a change of direction)."""
+        best, best_c = math.inf, 0.0
+        for i in range(-50, 51):
+            c = i / 50
+            x, y = self.path(leg, c)
+            d = (x - pos[0]) ** 2 + (y - pos[1]) ** 2
+            if d < best:
+                best, best_c = d, c
+        return best_c
+
+    def _move(self, pos: tuple[float, float], dc: float) -> tuple[float, float]:
+        """A stance foot after the body moved dc strokes: one rigid motion for every stance foot."""
+        vx, vy, w = MOTION[self.command]
+        a = -dc * self.p.turn_stroke_rad * w
+        ca, sa = math.cos(a), math.sin(a)
+        x, y = pos
+        return (ca * x - sa * y - dc * self.stroke * vx, sa * x + ca * y - dc * self.stroke * vy)
+
+    # --- commands ------------------------------------------------------------------------
     def set_command(self, cmd: int) -> None:
         """Apply a Mov_Cmd: 0..6 set the direction, 7..9 the gait (seed 3.2.3)."""
-        if cmd in (TRIPOD, RIPPLE, WAVE):
-            self._set_gait(cmd)
-        elif cmd in MOTION and cmd != self.command:
-            self.command = cmd
-            # react now (seed 5.2), not at the next step: every moving leg re-aims its current segment
+        if cmd in GAITS:
+            if cmd != self.gait and not self.lost:     # CHOICE: on five legs only the five-legged wave
+                self.gait = cmd
+                self.gait_switches += 1
+                self.pending = True          # seed 3.2.3: the direction stays; the feet re-phase when all are down
+            return
+        if cmd not in MOTION or cmd == self.command:
+            return
+        self.command = cmd
+        # react now (seed 5.2): stance feet carry on in the new direction from where they are,
+        # swinging feet re-aim their touchdown; the phase is re-fitted once every foot is down
+        for leg in self.legs:
+            pl = self.plans[leg]
+            if pl.swing:
+                left = pl.t0 + pl.dur - self.t
+                if left >= T.GAIT_MIN_SWING * self.t_swing:   # else it lands where it aimed
+                    x, y, z = self.target(leg)                  # re-aimed from where it is (as the LCP does)
+                    pl.pos, pl.z0, pl.t0, pl.dur = (x, y), z, self.t, left
+                    pl.end = self.path(leg, 0.5) if cmd != STOP else self.neutral(leg)
+                    pl.cmd = cmd
+            else:
+                pl.c = self._project(leg, pl.pos) if cmd != STOP else 0.0
+        self.pending = True
+
+    def drop_leg(self, leg: int) -> None:
+        """A leg is lost (seed 6.3: five of six suffice): walk the five-legged wave from the next all-feet-down."""
+        if leg in self.lost or leg not in self.legs:
+            return
+        self.lost.add(leg)
+        self.legs = tuple(lg for lg in self.legs if lg != leg)
+        self.gait = WAVE                             # STATUS_ACK: a wave over five legs
+        self.pending = True
+
+    # --- clock -------------------------------------------------------------------------------
+    def advance(self, dt: float) -> None:
+        """One gait-clock step: touchdowns, the re-phase once every foot is down, lift-offs, then the body motion."""
+        dt *= self.scale
+        self.dt = dt
+        # events at the start of the step, then the motion over it
+        for leg in self.legs:                                  # touchdowns first
+            pl = self.plans[leg]
+            if pl.swing and self.t >= pl.t0 + pl.dur - dt / 2:      # lands on the tick nearest its time
+                pl.swing, pl.pos, pl.z0 = False, pl.end, 0.0
+                if self.command == STOP:
+                    pl.c = 0.0
+                else:
+                    pl.c = 0.5 if pl.cmd == self.command else self._project(leg, pl.pos)
+        if self.pending and not any(self.plans[leg].swing for leg in self.legs):
+            self.pending = False
+            want = FIVE_LEGGED if self.lost else self.gait
+            if want != self.running:
+                self._set_pattern(want)
+                for leg in self.legs:                          # new neutral points and stroke
+                    self.plans[leg].c = self._project(leg, self.plans[leg].pos)
+            if self.command != STOP:
+                self._rephase()
+        self.t += dt
+        if self.command == STOP:
+            return
+        if not self.pending:                                   # no new swing until every foot is down
+            up = sum(1 for leg in self.legs if self.plans[leg].swing)
             for leg in self.legs:
                 pl = self.plans[leg]
-                if pl.active:
-                    x, y, _ = self.target(leg)
-                    pl.start, pl.end, pl.s0 = (x, y), self._foot_end(leg, pl.swing), self._local(leg)[1]
+                due = self.phase >= pl.next_lift - 0.5 * dt / self.cycle      # on the tick nearest its time
+                if not pl.swing and due and up < self.max_up:   # never more feet up than the pattern lifts
+                    up += 1
+                    late = max(0.0, (self.phase - pl.next_lift) * self.cycle)
+                    self._lift(leg, max(self.t_swing * T.GAIT_MIN_SWING, self.t_swing - late))
+                    while pl.next_lift - 0.5 * dt / self.cycle <= self.phase:
+                        pl.next_lift += 1.0
+        self.phase += dt / self.cycle
+        # stance: one rigid body motion for every stance foot, unless one would leave its workspace
+        dc = dt / self.t_stance
+        stance = [self.plans[leg] for leg in self.legs if not self.plans[leg].swing]
+        self.paused = any(pl.c - dc < -0.5 - T.GAIT_OVERRUN for pl in stance)
+        if self.paused:
+            self.pause_s += dt
+        else:
+            for pl in stance:
+                pl.pos = self._move(pl.pos, dc)
+                pl.c -= dc
 
-    def _foot_end(self, leg: int, swing: bool) -> tuple[float, float]:
-        vx, vy, w = MOTION[self.command]
-        nx, ny = self.p.neutral_foot(leg)
-        sign = 0.5 if swing else -0.5        # swing ends ahead, stance ends behind
-        stroke = self.p.stroke
-        a = sign * self.p.turn_stroke_rad * w
-        c, s = math.cos(a), math.sin(a)
-        return (c * nx - s * ny + sign * stroke * vx, s * nx + c * ny + sign * stroke * vy)
+    def _lift(self, leg: int, dur: float) -> None:
+        pl = self.plans[leg]
+        pl.swing, pl.t0, pl.dur, pl.z0 = True, self.t - self.dt, dur, 0.0   # the step began this tick
+        pl.end, pl.cmd = self.path(leg, 0.5), self.command
+        pl.lift = self.swing_lift
 
-    def _local(self, leg: int) -> tuple[bool, float]:
-        u = (self.phase - self.offset[leg]) % 1.0
-        if u < self.duty:
-            return False, u / self.duty
-        return True, (u - self.duty) / (1 - self.duty)
-
-    def advance(self, dt: float) -> None:
-        moving = self.command != STOP or any(pl.active for pl in self.plans.values())
-        if not moving:
-            return
-        if self.command != STOP and not any(pl.active for pl in self.plans.values()):
-            self.phase = 0.0      # start from a clean tripod boundary, not mid-stride
-        self.phase = (self.phase + dt / self.cycle) % 1.0
+    def _rephase(self) -> None:
+        """Choose the new pattern's phase that fits where the stance feet are (no foot overruns its stroke)."""
+        best, best_phi = math.inf, 0.0
+        for i in range(T.GAIT_REPHASE_STEPS):
+            phi = i / T.GAIT_REPHASE_STEPS
+            cost = 0.0
+            for leg in self.legs:
+                u = (phi - self.offset[leg]) % 1.0
+                c = self.plans[leg].c
+                if u < self.duty:                            # stance, (1 - s) strokes before lift-off
+                    s = u / self.duty
+                    over = max(0.0, -0.5 - (c - (1 - s)))
+                    cost += T.GAIT_OVERRUN_WEIGHT * over * over + (c - (0.5 - s)) ** 2
+                else:                                        # would lift now, with what is left of its swing
+                    s = (u - self.duty) / (1 - self.duty)
+                    if 1 - s < T.GAIT_MIN_SWING:
+                        cost += T.GAIT_OVERRUN_WEIGHT
+                    cost += (c + 0.5) ** 2 + s * s
+            if cost < best - 1e-12:
+                best, best_phi = cost, phi
+        self.phase = math.floor(self.phase) + 1.0 + best_phi
         for leg in self.legs:
-            swing, _ = self._local(leg)
             pl = self.plans[leg]
-            if swing != pl.swing or not pl.active:
-                if not pl.active and self.command == STOP:
-                    continue
-                cur = self.target(leg)[:2]
-                pl.swing = swing
-                pl.start = cur
-                pl.end = self._foot_end(leg, swing)
-                pl.lift = self.p.lift + self.lift_boost.pop(leg, 0.0)
-                pl.s0 = 0.0
-                at_home = math.dist(cur, pl.end) < 1e-3
-                pl.active = not (self.command == STOP and at_home)
+            u = (best_phi - self.offset[leg]) % 1.0
+            pl.next_lift = self.phase - (u - self.duty) if u >= self.duty else self.phase + (self.duty - u)
 
-    def boost_lift(self, leg: int, extra: float) -> None:
-        """LCP reflex (seed 6.1): the next swing of `leg` lifts `extra` metres higher."""
-        self.lift_boost[leg] = extra
+    def set_scale(self, scale: float) -> None:
+        """Slow the whole gait down (servo over-temperature) or back to full speed."""
+        self.scale = scale
+
+    # --- what the legs are told ------------------------------------------------------------------
+    def target(self, leg: int) -> tuple[float, float, float]:
+        """Where the foot is now: (x, y, height) in the body frame."""
+        pl = self.plans[leg]
+        if not pl.swing:
+            return (pl.pos[0], pl.pos[1], 0.0)
+        s = min(1.0, (self.t - pl.t0) / pl.dur) if pl.dur > 0 else 1.0
+        return swing_point((pl.pos[0], pl.pos[1], pl.z0), pl.end, pl.lift, s, T.LCP_SWING_EDGE)
+
+    def segment(self, leg: int) -> tuple[bool, tuple[float, float], float, float]:
+        """(swing, end point, lift, gait seconds left) of the leg's current segment.
+
+        Stance: the point where the foot will lift off if the body keeps moving (held: where it is).
+        """
         pl = self.plans[leg]
         if pl.swing:
-            pl.lift = max(pl.lift, self.p.lift + extra)
-
-    def target(self, leg: int) -> tuple[float, float, float]:
-        pl = self.plans[leg]
-        if not pl.active:
-            return (pl.end[0], pl.end[1], 0.0)
-        _, s = self._local(leg)
-        u = 1.0 if pl.s0 >= 1.0 else max(0.0, (s - pl.s0) / (1.0 - pl.s0))
-        x = pl.start[0] + (pl.end[0] - pl.start[0]) * u
-        y = pl.start[1] + (pl.end[1] - pl.start[1]) * u
-        z = pl.lift * math.sin(math.pi * s) if pl.swing else 0.0
-        return (x, y, z)
+            return True, pl.end, pl.lift, max(0.0, pl.t0 + pl.dur - self.t)
+        if self.command == STOP or self.paused:
+            return False, pl.pos, 0.0, 0.0
+        # until the re-phase the lift-off is not known: aim at the end of the foot's workspace
+        # whole ticks: the foot lifts on the tick nearest its time
+        left = math.inf if self.pending else max(0.0, round((pl.next_lift - self.phase) * self.cycle / self.dt) * self.dt)
+        dc = max(0.0, min(left / self.t_stance, pl.c + 0.5 + T.GAIT_OVERRUN))
+        return False, self._move(pl.pos, dc), 0.0, dc * self.t_stance
 
     def in_swing(self, leg: int) -> bool:
-        return self.plans[leg].active and self.plans[leg].swing
+        return self.plans[leg].swing
+
+    def speed(self) -> tuple[float, float]:
+        """Nominal body speed (m/s) and turn rate (rad/s) of the running pattern at full scale."""
+        return self.stroke / self.t_stance, self.p.turn_stroke_rad / self.t_stance

@@ -59,9 +59,21 @@ class Hardware(Protocol):
     def sole_contact(self) -> bool:
         """LCP: the sole switch of its foot (seed 1.2.2)."""
 
+    # -- level-0 peripherals (seed 3.2.7, 3.2.8) ------------------------------------------
+    def rcp_read(self) -> bytes:
+        """UIC/RCP: bytes the operator's VT100 terminal sent on the RS-232 line since the last read (UART FIFO)."""
+
+    def rcp_write(self, data: bytes) -> None:
+        """UIC/RCP: bytes to the terminal on the RS-232 line (VT100 escape sequences)."""
+
+    def sound_event(self) -> tuple[float, float] | None:
+        """APU/SDF: the oldest sound event not yet read: (direction in degrees, body frame, counter-clockwise
+        from forward; level in dB at the microphones), or None when nothing was heard."""
+
     # -- servo (JAC) ----------------------------------------------------------------------
-    def set_servo(self, angle: float, speed: float) -> None:
-        """JAC: drive the servo to `angle` rad at `speed` rad/s."""
+    def set_servo_drive(self, speed: float | None) -> None:
+        """JAC: the servo's output stage: turn at `speed` rad/s (signed; the JAC closes the position loop);
+        None stops the pulses and the servo goes limp."""
 
     def servo_state(self) -> ServoState:
         """JAC: the servo's feedback."""

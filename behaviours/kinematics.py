@@ -36,3 +36,29 @@ def ik(p: RobotGeometry, leg: int, fx: float, fy: float, fz: float) -> tuple[flo
     q3 = math.acos(d)                        # knee bend, knee above the hip-foot line
     q1 = math.atan2(z, r) + math.atan2(L2 * math.sin(q3), L1 + L2 * math.cos(q3))
     return (q1, q2, q3)
+
+
+def _smooth(u: float) -> float:
+    """Smoothstep: 0 -> 1 with zero slope at both ends (no jerk at a phase change)."""
+    u = 0.0 if u < 0.0 else 1.0 if u > 1.0 else u
+    return u * u * (3.0 - 2.0 * u)
+
+
+def swing_point(start: tuple[float, float, float], end: tuple[float, float], lift: float, s: float,
+                edge: float) -> tuple[float, float, float]:
+    """The foot at progress s (0..1) of a swing: lift-off, transfer, touch-down (seed 3.2.10 trajectories).
+
+    The first `edge` of the swing lifts the foot straight up from `start` to `lift`, the middle
+    carries it at that height to above `end`, the last `edge` lowers it straight down onto `end`
+    (a foot neither drags over the ground nor lands with a horizontal speed). A swing that starts
+    in the air (re-planned mid-swing) spends only the part of the lift phase it still needs.
+    """
+    x0, y0, z0 = start
+    up = edge * max(0.0, lift - z0) / lift if lift > 0 else 0.0
+    down = 1.0 - edge
+    if s < up:
+        return (x0, y0, z0 + (lift - z0) * _smooth(s / up))
+    if s <= down:
+        u = _smooth((s - up) / (down - up)) if down > up else 1.0
+        return (x0 + (end[0] - x0) * u, y0 + (end[1] - y0) * u, max(z0, lift))
+    return (end[0], end[1], max(z0, lift) * (1.0 - _smooth((s - down) / edge)))

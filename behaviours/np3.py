@@ -1,113 +1,370 @@
-"""NP3 (seed 3.2.3, 5.1-5.2, 6): navigation as layered behaviours (subsumption, decision 8).
+"""NP3 (seed 3.2.3, 3.3.2, 5.1-5.2, 6): navigation as a subsumption network (decision 8).
 
-Layers, highest priority first: stop when the IR sensor is unreliable (6.2);
-escape a whisker or IR contact (5.2: react within about 1 s); then the task
-(forward, explore, wall_follow, seek_light, avoid_light, idle). Each wish
-becomes a MOVE record sent through the MCP's message scheduling (3.2.2):
-XMIT_REQ, then MOVE when the MCP grants the bus.
+The node owns the network of behaviours.np3_layers and evaluates it every
+NP3 period (and at once after a record that may need a reflex, 5.2). Its
+sensor registers are filled ONLY from the DATA records the MCP delivers
+(address = source node, kind VALUE / ALARM / STATUS, channel, value in the
+source's XMIT_DATA encoding, decoded with the spec's conversions). The
+actuator "move" leaves as a MOVE record through the MCP's message
+scheduling (3.2.2): XMIT_REQ, then MOVE when the MCP grants the bus.
+
+Beside the network the node keeps a dead-reckoned pose (CHOICE: from its own
+MOVE commands and the gait's nominal speeds) and the topological map of
+seed 3.3.2, built from the USRC's echoes (channel = head angle); exploring
+heads for the map's frontier. debug_metrics() reports which layer held the
+MMC for how long; write_artifacts() writes control.tsv and topomap.png.
 """
 from __future__ import annotations
 
+import math
+from collections import deque
+from pathlib import Path
+from typing import Any
+
 from arachnae_proto import messages as M
-from arachnae_proto.enums import MovCmd, TpscContact
+from arachnae_proto.enums import MmcError, MovCmd, RangeStatus, RecordKind, TpscContact
 from arachnae_proto.network import ADDRESS_OF, NODES
 from arachnae_proto.skeletons.np3 import Np3Skeleton
 
 from behaviours import tuning as T
+from behaviours.np3_layers import AVOIDANCE, REFLEXES, np3_network
 from behaviours.runtime import Runtime
-from behaviours.units import quantizer
+from behaviours.topomap import OCCUPIED, OccupancyGrid, Reading, TopoMap
+from behaviours.units import Quantizer, quantizer
 
-_IR = quantizer(M.XmitDataIrrc, "center")           # cm on the wire
+_VALUE, _ALARM, _STATUS = int(RecordKind.VALUE), int(RecordKind.ALARM), int(RecordKind.STATUS)
+_IR_BAD = {int(RangeStatus.UNRELIABLE), int(RangeStatus.OUT_OF_ORDER)}
+_NO_GROUND, _BLOCKED = int(MmcError.NO_GROUND), int(MmcError.LEG_DRIVE_BLOCKED)
 _STOP, _FORWARD, _BACKWARD = int(MovCmd.STOP), int(MovCmd.FORWARD), int(MovCmd.BACKWARD)
-_TURN_LEFT, _TURN_RIGHT, _TRIPOD = int(MovCmd.TURN_LEFT), int(MovCmd.TURN_RIGHT), int(MovCmd.TRIPOD)
-_OBJ_LEFT = int(TpscContact.OBJ_LEFT)
-_LATER = -1                                           # escape plan step: back to the task
+_LEFT, _RIGHT = int(MovCmd.TURN_LEFT), int(MovCmd.TURN_RIGHT)
+_SIDE_L, _SIDE_R = int(MovCmd.SIDESTEP_LEFT), int(MovCmd.SIDESTEP_RIGHT)
+# each source role's XMIT_DATA layout and the field whose encoding its records carry (spec messages)
+_XMIT_DATA = {m.SENDERS[0]: m for m in M.MESSAGES if m.SEED_NAME == "XMIT_DATA" and m is not M.XmitData}
+_FIELD = {"IRRC": "center", "ISC": "longitudinal", "LSC": "brightness", "PSC": "voltage", "USRC": "distance"}
+_Q: dict[str, Quantizer] = {role: quantizer(_XMIT_DATA[role], f) for role, f in _FIELD.items()}
+
+
+def decode(role: str, value: int) -> float:
+    """A record's value byte in the physical unit of `role`'s XMIT_DATA field (signed fields: two's complement)."""
+    q = _Q[role]
+    if q.lo < 0 and value > 127:
+        value -= 256
+    return q.phys(value)
+
+
+class DeadReckoning:
+    """The pose the NP3 believes in: its own MOVE commands at the gait's measured speeds (CHOICE, no odometry)."""
+
+    def __init__(self, speed_m_s: float, turn_rad_s: float, side_m_s: float | None = None) -> None:
+        self.x = self.y = self.th = 0.0
+        self.speed, self.turn = speed_m_s, turn_rad_s
+        self.side = speed_m_s if side_m_s is None else side_m_s
+        self.cmd = _STOP
+        self.t: float | None = None
+
+    def advance(self, now: float) -> None:
+        dt = 0.0 if self.t is None else max(0.0, now - self.t)
+        self.t = now
+        v = self.speed if self.cmd == _FORWARD else -self.speed if self.cmd == _BACKWARD else 0.0
+        u = self.side if self.cmd == _SIDE_L else -self.side if self.cmd == _SIDE_R else 0.0
+        w = self.turn if self.cmd == _LEFT else -self.turn if self.cmd == _RIGHT else 0.0
+        a = self.th + w * dt / 2
+        self.x += (v * math.cos(a) - u * math.sin(a)) * dt
+        self.y += (v * math.sin(a) + u * math.cos(a)) * dt
+        self.th = (self.th + w * dt + math.pi) % (2 * math.pi) - math.pi
+
+    def command(self, now: float, cmd: int) -> None:
+        self.advance(now)
+        if cmd < int(MovCmd.TRIPOD):            # a direction; 7..9 only change the gait
+            self.cmd = cmd
+
+    @property
+    def pose(self) -> tuple[float, float, float]:
+        return self.x, self.y, self.th
 
 
 class NP3(Runtime, Np3Skeleton):
     def start(self) -> None:
+        g = self.cfg.geometry
         self.running = False
-        self.sent_cmd: int | None = None
-        self.outbox: list[int] = []
-        self.escape_until = -1.0
-        self.escape_plan: list[tuple[float, int]] = []
-        self.last_light: int | None = None
-        self.light_check = 0.0
-        self.ir_unreliable = False
+        self.layers = np3_network(lambda: self.now, self.cfg.task)
+        self.odo = DeadReckoning(T.NP3_DR_SPEED_M_S, math.radians(T.NP3_DR_TURN_DEG_S), T.NP3_DR_SIDE_M_S)
+        self.geo = g
+        self.echoes: deque[tuple[float, ...]] = deque()   # (time, x, y, body angle seen at, arc half width m)
+        half = T.NP3_MAP_SIZE_M / 2
+        self.map = TopoMap(OccupancyGrid(-half, -half, 2 * half, 2 * half, T.NP3_MAP_CELL_M),
+                           robot_radius_m=g.body_width, place_spacing_m=1.0)
+        self.body_r = g.body_width / 2
+        self.pending: int | None = None       # the latest wish, waiting for the MCP's grant
+        self.sent_module = ""
+        self.doubt = False
+        self.requested = False
+        self.sent: tuple[int, str] | None = None   # (command, module) of the last MOVE
+        self.moves_sent = 0
+        self.holder = ""                      # module holding the actuator after the last step
+        self.takeovers: dict[str, int] = {}
+        # registers and what the records told so far
+        self.ir: list[float | None] = [None, None, None]
+        self.tilt = [0.0, 0.0]
+        self.seq = {"whisker": 0, "pit": 0, "leg_blocked": 0, "light": 0, "sound": 0}
+        self.mmc_error = (0, 0)
+        self.battery_low = False
+        self.low_volts = 0
+        self.ir_fault = False
+        self.sonar_ignored = False
+        self.sonar_ahead: tuple[float, float] | None = None    # (time, metres)
+        self.records = 0
+        self.lux: list[float] = []
+        self.next_plan = 0.0
+        self.goal: tuple[float, float] | None = None
+        self.visited: set[tuple[int, int]] = set()
+        self.last_cell: tuple[int, int] | None = None
         self.every(T.NP3_PERIOD_S, self.tick)
 
     def on_init(self, src: int, msg: M.Init) -> None:
-        """seed 3.2.3: INIT from the MCP after POST starts navigation."""
-        self.running = True
-        self.want(_TRIPOD)
-        self.want(self.task_command())
+        """seed 3.2.3: INIT from the MCP after POST starts navigation with a zeroed world model."""
+        if not self.running:
+            self.running = True
+            self.tick()
 
-    def task_command(self) -> int:
-        return _STOP if self.cfg.task == "idle" else _FORWARD
-
-    # --- moving: XMIT_REQ -> XMIT_GRANT -> MOVE (seed 3.2.2) ---------------------------
-    def want(self, mov_cmd: int) -> None:
-        if mov_cmd == self.sent_cmd and not self.outbox:
+    # --- the network, every period ---------------------------------------------------------
+    def tick(self) -> None:
+        if not self.running:
             return
-        self.outbox.append(mov_cmd)
-        if len(self.outbox) == 1:
+        now = self.now
+        self.odo.advance(now)
+        x, y, th = self.odo.pose
+        self.map.grid.mark_free(x, y, self.body_r)
+        self.map.visit(x, y)
+        ahead = self.sonar_ahead
+        fresh = ahead is not None and now - ahead[0] <= T.NP3_SONAR_FRESH_S and not self.sonar_ignored
+        while self.echoes and now - self.echoes[0][0] > T.NP3_ECHO_KEEP_S:
+            self.echoes.popleft()
+        self.layers.sense(pose=(x, y, th), sonar_ahead_m=ahead[1] if fresh else None,
+                          echoes=tuple(e[1:] for e in self.echoes))
+        if self.cfg.task == "explore":
+            self.mark_visited(x, y)
+            goal = self.goal
+            if now >= self.next_plan or (goal is not None and math.hypot(goal[0] - x, goal[1] - y)
+                                         < T.NP3_GOAL_REACHED_M):
+                self.plan_goal(now)
+        cmd = self.layers.step()["move"]
+        trace = self.layers.trace("move")
+        _since, layer, module = trace.current
+        if module != self.holder:
+            self.holder = module
+            self.takeovers[module] = self.takeovers.get(module, 0) + 1
+            plan = getattr(self.layers.modules.get(module), "plan", None)
+            if layer in (REFLEXES, AVOIDANCE) and plan is not None:   # the manoeuvre's window (5.2 latency metric)
+                self.hw.note("escape", start=now, end=plan.started + sum(d for d, _v in plan.steps), module=module)
+        if self.doubt and self.sent is not None and self.pending is None and not self.requested:
+            self.doubt = False             # seed 3.2.2: the MOVE after a repeated grant may be lost too: send it again
+            self.pending, self.sent_module = self.sent
+            self.requested = True
+            self.slave_send(ADDRESS_OF["MCP"], M.XmitReq())
+        if cmd is not None:
+            self.want(int(cmd), module)
+
+    def plan_goal(self, now: float) -> None:
+        """seed 3.3.2 / 5.2: every NP3_EXPLORE_PLAN_S, or when the goal is reached, pick the heading whose ray
+        through the map runs longest over cells the robot has not passed yet before a mapped obstacle,
+        and set a goal along it (short of the obstacle)."""
+        self.next_plan = now + T.NP3_EXPLORE_PLAN_S
+        x, y, th = self.odo.pose
+        g = self.map.grid
+        best: tuple[float, float, float] | None = None          # (score, heading, free length)
+        for k in range(T.NP3_EXPLORE_HEADINGS):
+            turn = (2 * math.pi * k / T.NP3_EXPLORE_HEADINGS + math.pi) % (2 * math.pi) - math.pi
+            h = th + turn
+            free = fresh = 0.0
+            r = 0.0
+            while r < T.NP3_EXPLORE_REACH_M:
+                r += g.res
+                cell = g.cell(x + r * math.cos(h), y + r * math.sin(h))
+                if not g.inside(*cell) or g.state(*cell) == OCCUPIED:
+                    break
+                free = r
+                fresh += g.res * (cell not in self.visited)
+            score = fresh + 0.2 * free - 0.3 * abs(turn)
+            if free > T.NP3_EXPLORE_MARGIN_M and (best is None or score > best[0]):
+                best = (score, h, free)
+        if best is None:
+            self.goal = None
+        else:
+            length = min(best[2] - T.NP3_EXPLORE_MARGIN_M, T.NP3_EXPLORE_GOAL_M)
+            self.goal = (x + length * math.cos(best[1]), y + length * math.sin(best[1]))
+        self.layers.sense(goal=self.goal)
+
+    def mark_visited(self, x: float, y: float) -> None:
+        """The map cells within NP3_EXPLORE_SEEN_M of the dead-reckoned path (what exploring has covered)."""
+        g = self.map.grid
+        ci, cj = g.cell(x, y)
+        if (ci, cj) == self.last_cell:
+            return
+        self.last_cell = (ci, cj)
+        n = int(T.NP3_EXPLORE_SEEN_M / g.res)
+        self.visited.update((ci + di, cj + dj) for di in range(-n, n + 1) for dj in range(-n, n + 1)
+                            if di * di + dj * dj <= n * n)
+
+    # --- moving: XMIT_REQ -> XMIT_GRANT -> MOVE (seed 3.2.2) -----------------------------------
+    def want(self, mov_cmd: int, module: str) -> None:
+        """Send a MOVE when the command changes or another module takes over (it reacts, 5.2)."""
+        if self.sent == (mov_cmd, module) and self.pending is None:
+            return
+        if self.sent is not None and self.sent[0] == mov_cmd and self.pending is None and module == "task":
+            self.sent = (mov_cmd, module)         # back to the task with the same command: nothing to send
+            return
+        self.pending = mov_cmd
+        self.sent_module = module
+        if not self.requested:
+            self.requested = True
             self.slave_send(ADDRESS_OF["MCP"], M.XmitReq())
 
     def on_xmit_grant(self, src: int, msg: M.XmitGrant) -> None:
-        if not self.outbox:
-            if self.sent_cmd is not None:      # a repeated grant: our record did not get through
-                self.send(src, M.Move(mov_cmd=self.sent_cmd, param=0))
+        self.requested = False
+        if self.pending is None:
+            if self.sent is not None:      # a repeated grant: our record did not get through
+                self.send(src, M.Move(mov_cmd=self.sent[0], param=0))
+                self.doubt = True          # it may be lost again: ask for the bus once more next period
             return
-        mov = self.outbox.pop(0)
-        self.sent_cmd = mov
+        mov, self.pending = self.pending, None
+        self.sent = (mov, self.sent_module)
+        self.moves_sent += 1
+        self.odo.command(self.now, mov)
         self.send(src, M.Move(mov_cmd=mov, param=0))
-        if self.outbox:
-            self.slave_send(src, M.XmitReq())
 
-    # --- sensing --------------------------------------------------------------
+    # --- sensing: DATA records only ----------------------------------------------------------------
     def on_data(self, src: int, msg: M.Data) -> None:
-        if not self.running or msg.address not in NODES:
+        if msg.address not in NODES:
             return
-        role, v = NODES[msg.address][1], msg.value
-        if role == "TPSC" and v:
-            self.escape(v)
-        elif role == "IRRC":
-            if _IR.phys(v) / 100 < T.NP3_IR_NEAR_M:
-                self.escape(0)
+        self.records += 1
+        role, kind, ch, v = NODES[msg.address][1], msg.kind, msg.channel, msg.value
+        urgent = True
+        if role == "MMC" and kind == _STATUS:
+            self.mmc_status(ch, v)
+        elif kind == _STATUS and role in ("IRRC", "USRC"):
+            self.range_status(role, v)
+        elif role == "TPSC" and v:
+            left = bool(v & (TpscContact.OBJ_LEFT | TpscContact.OBJ_BOTH))
+            right = bool(v & (TpscContact.OBJ_RIGHT | TpscContact.OBJ_BOTH))
+            self.bump("whisker", left, right, self.now)                 # seed 3.2.12
+            for side, hit in ((1.0, left), (-1.0, right)):              # the touch: half way along the whisker
+                if hit:
+                    self.echo(T.NP3_BODY_FRONT_M, side * self.geo.body_width / 2, side * T.NP3_WHISKER_DEG,
+                              T.NP3_WHISKER_M / 2)
+        elif role == "IRRC" and 0 <= ch < 3:                            # seed 3.2.13: beam 0 left, 1 centre, 2 right
+            self.ir[ch] = None if v >= _Q["IRRC"].hi else decode(role, v) / 100
+            if self.ir[ch] is not None:
+                self.echo(T.NP3_BODY_FRONT_M, 0.0, (1 - ch) * T.NP3_IR_BEAM_DEG, self.ir[ch])
+            self.layers.sense(ir=tuple(self.ir))
+        elif role == "ISC" and ch in (0, 1):                            # seed 3.2.14: axis 0 / 1
+            self.tilt[ch] = decode(role, v)
+            self.layers.sense(tilt=tuple(self.tilt))
+        elif role == "PSC":                                             # seed 3.2.17: under-voltage stops the robot
+            self.low_volts = self.low_volts + 1 if decode(role, v) < T.NP3_BATTERY_LOW_V else 0
+            if kind == _ALARM or self.low_volts >= T.NP3_BATTERY_LOW_COUNT:   # a load dip is no under-voltage
+                self.battery_low = True
+                self.layers.sense(battery_low=True)
         elif role == "LSC":
-            self.light(v)
+            self.light(decode(role, v))
+            urgent = False
+        elif role == "USRC":
+            self.sonar(ch, v)
+            urgent = False
+        elif role == "APU_SDF" and kind == _VALUE:                      # seed 3.2.7: sound direction, body frame
+            self.bump("sound", ch)
+        else:
+            urgent = False
+        if urgent and self.running:
+            self.tick()                                                 # 5.2: react now, not next period
 
-    def escape(self, contact: int) -> None:
-        if self.ir_unreliable or self.now < self.escape_until:
-            return
-        turn = _TURN_RIGHT if contact == _OBJ_LEFT else _TURN_LEFT
-        t = self.now
-        self.escape_plan = [(t + T.NP3_ESCAPE_BACK_S, turn), (t + T.NP3_ESCAPE_BACK_S + T.NP3_ESCAPE_TURN_S, _LATER)]
-        self.escape_until = t + T.NP3_ESCAPE_BACK_S + T.NP3_ESCAPE_TURN_S
-        self.hw.note("escape", start=t, end=self.escape_until)
-        self.want(_BACKWARD)
+    def bump(self, register: str, *data: Any) -> None:
+        self.seq[register] += 1
+        self.layers.sense(**{register: (self.seq[register], *data) if data else self.seq[register]})
 
-    def light(self, v: int) -> None:
-        task = self.cfg.task
-        if task not in ("seek_light", "avoid_light") or self.now < self.escape_until or self.now < self.light_check:
-            return
-        self.light_check = self.now + T.NP3_LIGHT_CHECK_S
-        if self.last_light is not None:
-            worse = v < self.last_light if task == "seek_light" else v > self.last_light
-            if worse:
-                self.escape_plan = [(self.now + T.NP3_ESCAPE_BACK_S, _LATER)]
-                self.escape_until = self.now + T.NP3_ESCAPE_BACK_S
-                self.want(_TURN_LEFT)
-        self.last_light = v
+    def mmc_status(self, leg: int, error: int) -> None:
+        """MMC STATUS_ACK error as the MCP relays it: a pit or a blocked leg starts a reflex once per report."""
+        if (error, leg) != self.mmc_error:
+            if error == _NO_GROUND:
+                self.bump("pit")
+            elif error == _BLOCKED:
+                self.bump("leg_blocked", self.geo.side(leg) if leg in self.geo.legs else 0.0)
+        self.mmc_error = (error, leg)
 
-    def tick(self) -> None:
-        if not self.running or self.ir_unreliable:
+    def range_status(self, role: str, status: int) -> None:
+        bad = status in _IR_BAD
+        if role == "IRRC":                       # seed 6.2: IR not trustworthy -> stop
+            self.ir_fault = bad
+            self.layers.sense(ir_fault=bad)
+        else:                                    # seed 6.2: US not trustworthy -> its data are ignored
+            self.sonar_ignored = bad
+            if bad:
+                self.sonar_ahead = None
+
+    def echo(self, bx: float, by: float, rel_deg: float, d: float, cone_deg: float = 0.0) -> None:
+        """An obstacle point seen from (bx, by) in the body frame, d m away at rel_deg, kept in world (DR) terms
+        with the angle it was seen at: the local memory the tasks steer by (sonar sector minima come ~8 s apart)."""
+        self.odo.advance(self.now)
+        x, y, th = self.odo.pose
+        a = th + math.radians(rel_deg)
+        ox, oy = x + bx * math.cos(th) - by * math.sin(th), y + bx * math.sin(th) + by * math.cos(th)
+        arc = d * math.sin(math.radians(cone_deg / 2))        # the echo may come from anywhere across the cone
+        self.echoes.append((self.now, ox + d * math.cos(a), oy + d * math.sin(a), rel_deg, arc))
+
+    def light(self, lux: float) -> None:
+        self.lux.append(lux)
+        x, y, _ = self.odo.pose
+        self.seq["light"] += 1
+        self.layers.sense(light=(self.seq["light"], x, y, math.log10(max(lux, 1e-3))))
+
+    def sonar(self, head_deg: int, raw: int) -> None:
+        """seed 3.3.2: an echo (channel = head angle, body frame) into the map at the dead-reckoned pose."""
+        if self.sonar_ignored:
             return
-        t = self.now
-        while self.escape_plan and t >= self.escape_plan[0][0]:
-            _, cmd = self.escape_plan.pop(0)
-            self.want(self.task_command() if cmd == _LATER else cmd)
-        if self.cfg.task == "explore" and not self.escape_plan and int(t) % T.NP3_EXPLORE_EVERY_S == 0 \
-                and t - int(t) < T.NP3_PERIOD_S:
-            self.want(_TURN_LEFT)
-            self.escape_plan = [(t + T.NP3_EXPLORE_TURN_S, _LATER)]
+        d = None if raw >= _Q["USRC"].hi else decode("USRC", raw)
+        self.odo.advance(self.now)
+        x, y, th = self.odo.pose
+        rel = (head_deg + 180) % 360 - 180
+        if abs(rel) <= T.NP3_SONAR_AHEAD_DEG and d is not None:
+            self.sonar_ahead = (self.now, d)
+        if d is not None and d < T.NP3_ECHO_NEAR_M:
+            self.echo(0.0, 0.0, rel, d, T.NP3_SONAR_BEAM_DEG)
+        half, n = T.NP3_SONAR_BEAM_DEG / 2, 5
+        cone = [Reading(x, y, math.degrees(th), head_deg - half + 2 * half * k / (n - 1), d) for k in range(n)]
+        self.map.add(cone)
+
+    # --- debug port --------------------------------------------------------------------------------
+    def debug_metrics(self) -> dict[str, Any]:
+        """Which layer held the MMC and for how long (decision 8), reflex take-overs, map and light figures."""
+        if "move" not in self.layers.traces:
+            return {"control": {}, "switches": 0, "moves_sent": 0}
+        trace = self.layers.trace("move")
+        x, y, th = self.odo.pose
+        self.map.rebuild()
+        return {
+            "control": {k: round(v, 2) for k, v in trace.summary(self.now).items()},
+            "switches": trace.switches(self.now),
+            "takeovers": dict(sorted(self.takeovers.items())),
+            "moves_sent": self.moves_sent,
+            "records": self.records,
+            "pose": [round(x, 3), round(y, 3), round(math.degrees(th), 1)],
+            "battery_low": self.battery_low,
+            "ir_fault": self.ir_fault,
+            "sonar_ignored": self.sonar_ignored,
+            "map": {"places": len(self.map.places), "edges": len(self.map.edges),
+                    "seen_m2": round(sum(self.map.grid.seen) * self.map.grid.res ** 2, 2)},
+            "light": {"first_lux": round(self.lux[0], 1), "last_lux": round(self.lux[-1], 1),
+                      "ratio": round(self.lux[-1] / self.lux[0], 3)} if self.lux else {},
+        }
+
+    def write_artifacts(self, out_dir: Path) -> None:
+        """control.tsv (the control trace), wiring.txt (the declared network) and topomap.png (seed 3.3.2)."""
+        out = Path(out_dir)
+        rows = ["start_s\tend_s\tlayer\tmodule"]
+        if "move" in self.layers.traces:
+            rows += [f"{iv.start:.3f}\t{iv.end:.3f}\t{iv.layer}\t{iv.module}"
+                     for iv in self.layers.trace("move").intervals(self.now)]
+        (out / "control.tsv").write_text("\n".join(rows) + "\n")
+        (out / "wiring.txt").write_text(self.layers.wiring_table() + "\n")
+        self.map.rebuild()
+        self.map.save_png(out / "topomap.png")

@@ -69,9 +69,15 @@ class PostMaster:
     """Mixin (before Runtime) for every bus master: runs POST on its bus and answers POST_QUERY."""
 
     post_missing: list[int] | None = None      # None until this master's POST has finished
+    post_runs = 0                              # how many POSTs this master has run
+    _post_reported = False                     # its last POST's result went upward
+    _post_callback: Callable[[list[int]], None] | None = None
 
     def run_post(self, done: Callable[[list[int]], None] | None = None) -> None:
         self.post_missing = None
+        self.post_runs += 1
+        self._post_reported = False
+        self._post_callback = done
         self._post_waiting: list[int] = getattr(self, "_post_waiting", [])
         missing: list[int] = []
         retries = self.links[self.master_bus].timing.id_retries          # type: ignore[attr-defined]
@@ -86,6 +92,9 @@ class PostMaster:
 
         for a in slaves_of(self.master_bus):                              # type: ignore[attr-defined]
             def on_status(src: int, msg: M.Message, a: int = a) -> None:
+                hook = getattr(self, "post_status", None)
+                if hook is not None:
+                    hook(a, msg)                                           # the master keeps its slaves' status
                 if (type(msg), getattr(msg, "status", None)) in inactive:
                     lost(a)                                                # seed 6.3: declares itself inactive
 
@@ -115,6 +124,14 @@ class PostMaster:
 
         self.when_idle(query_subs)                                         # type: ignore[attr-defined]
 
+    def on_id_req(self, src: int, msg: M.IdReq) -> None:
+        """seed 6.3: POST can be started at any time. A sub-master asked for its ID again after it reported
+        its last POST (the master runs a new POST) runs its own POST again, so the new report is fresh."""
+        super().on_id_req(src, msg)                                        # type: ignore[misc]
+        if self._post_reported and self.post_missing is not None:
+            self.hw.note("post_rerun", node=self.name)                     # type: ignore[attr-defined]
+            self.run_post(self._post_callback)
+
     def on_post_query(self, src: int, msg: M.PostQuery) -> None:
         """seed 6.3: report when this master's own POST is done."""
         if self.post_missing is None:
@@ -123,4 +140,5 @@ class PostMaster:
             self._post_report(src)
 
     def _post_report(self, src: int) -> None:
+        self._post_reported = True
         self.send(src, M.PostReport(missing=self.post_missing or []))     # type: ignore[attr-defined]

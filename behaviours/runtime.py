@@ -186,7 +186,7 @@ class Runtime:
         if link is not None and link.current is not None and sent == link.frame:
             req, serial = link.current, link.current.serial
             if heard != sent:                      # seed 3.2.2: corrupt echo -> send again
-                self.hw.after(link.timing.turnaround_s, self._transmit, link, serial)
+                self.hw.after(self._master_resend_wait(link), self._transmit, link, serial)
             elif not req.expect:
                 link.current = None
                 self._next(link)
@@ -194,6 +194,16 @@ class Runtime:
                 self.hw.after(req.timeout, self._timeout, link, serial)
             return
         self._slave_echo(bus, sent, heard)
+
+    def _master_resend_wait(self, link: MasterLink) -> float:
+        """After a corrupt frame the master resends only once the slaves' backoff window has passed,
+        plus its usual defer slots: resending at once would meet the slave whose slot comes first, and
+        both would retry in lockstep forever (found in the simulator; the window is the spec's rule)."""
+        t = link.timing
+        if self.net.arbitration.get(link.bus) != "address_backoff":
+            return t.turnaround_s
+        window = len(self.net.requesters.get(link.bus, ())) * self.net.backoff_slots * t.slot_s
+        return window + self.net.protocol.master_defer_slots * t.slot_s
 
     # --- slave side -------------------------------------------------------------------------
     def slave_send(self, dst: int, msg: Message) -> None:

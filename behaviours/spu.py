@@ -1,85 +1,251 @@
-"""SPU (seed 3.2.5): master of the sensor bus; polls the sensors and forwards to the NP3.
+"""SPU (seed 3.2.5): master of the sensor bus; sets the sensors up, polls them and forwards to the NP3.
 
-After its POST it sets the USRC scanning (FREE_RUN) and polls the other
-sensors round-robin (tuning.SPU_CYCLE), the IRRC every second poll because
-close range matters most (5.2). A DATA_RDY is served before the next poll.
-Values the NP3 needs travel as XMIT_RECORDs through the MCP (3.2.2).
+After its POST the SPU sets up every sensor's SET_ALARM limit (tuning) and
+puts the USRC into FREE_RUN. Then it polls the other sensors round-robin
+(tuning.SPU_CYCLE, the IRRC every second poll because close range matters
+most, 5.2) and asks the range sensors for their status in turn. A DATA_RDY
+is served before the next poll: from the free-running USRC it announces a
+sector's nearest echo, from the TPSC a contact, from any other sensor an
+alarm (or, from the IRRC, a status change). What the NP3 needs travels as
+XMIT_RECORDs through the MCP (3.2.2): VALUE records (rate-limited per
+sensor channel), ALARM records for a crossed limit, STATUS records when a
+sensor's status changes. A sensor that stops answering counts as
+OUT_OF_ORDER; a range sensor that is not IN_ORDER is not trusted and its data
+is ignored (6.2).
 """
 from __future__ import annotations
 
+from typing import Any
+
 from arachnae_proto import messages as M
+from arachnae_proto.enums import IscAxis, RangeStatus, RecordKind
 from arachnae_proto.network import ADDRESS_OF, NODES
 from arachnae_proto.skeletons.spu import SpuSkeleton
 
 from behaviours import tuning as T
 from behaviours.post import PostMaster
-from behaviours.runtime import Runtime, slaves_of
+from behaviours.runtime import slaves_of
+from behaviours.sensors import ABOVE, BELOW, BEYOND, AfterReplies, AlarmLimit, limit_in
+from behaviours.units import quantizer
 
 # each sensor role's XMIT_DATA reply (the spec's XMIT_DATA_<role> layouts)
 REPLY_OF = {m.SENDERS[0]: m for m in M.MESSAGES if m.SEED_NAME == "XMIT_DATA" and m is not M.XmitData}
+# each sensor role's STATUS_ACK layout; the range sensors are the ones with UNRELIABLE (3.2.11, 3.2.13)
+STATUS_OF = {role: cls for cls in (M.StatusAckRange, M.StatusAckOrder) for role in cls.SENDERS}
+RANGE = tuple(M.StatusAckRange.SENDERS)
+_IN_ORDER, _OUT_OF_ORDER = int(RangeStatus.IN_ORDER), int(RangeStatus.OUT_OF_ORDER)   # same codes in ORDER_STATUS
+_VALUE, _ALARM, _STATUS = int(RecordKind.VALUE), int(RecordKind.ALARM), int(RecordKind.STATUS)
+_KIND_NAME = {int(k): k.name.lower() for k in RecordKind}
 
 
-class SPU(PostMaster, Runtime, SpuSkeleton):
+def channels(role: str, msg: Any) -> dict[int, int]:
+    """A sensor's reply as {record channel: raw value} (the record contract: IRRC beam, ISC axis,
+    TSC probe, USRC head angle; 0 otherwise)."""
+    if role == "USRC":
+        return {msg.angle: msg.distance}
+    if role == "IRRC":
+        return {0: msg.left, 1: msg.center, 2: msg.right}
+    if role == "ISC":
+        return {int(IscAxis.LONGITUDINAL): msg.longitudinal, int(IscAxis.TRANSVERSE): msg.transverse}
+    if role == "TSC":
+        return {msg.channel: msg.temperature}
+    field = REPLY_OF[role].FIELDS[0].name
+    return {0: getattr(msg, field)}
+
+
+def alarm_setup() -> list[tuple[str, M.Message, list[tuple[int, AlarmLimit]]]]:
+    """The SET_ALARM frames for each sensor role with the limits (in the data's raw steps) they set, per channel."""
+    ir, isc = quantizer(M.XmitDataIrrc, "center"), quantizer(M.XmitDataIsc, "longitudinal")
+    tsc, lsc, psc = (quantizer(M.XmitDataTsc, "temperature"), quantizer(M.XmitDataLsc, "brightness"),
+                     quantizer(M.XmitDataPsc, "voltage"))
+    out: list[tuple[str, M.Message, list[tuple[int, AlarmLimit]]]] = []
+    m: M.Message = M.SetAlarmIrrc.from_phys(limit=T.SPU_ALARM_IRRC_CM)           # seed 3.2.13
+    out.append(("IRRC", m, [(b, AlarmLimit(limit_in(ir, M.SetAlarmIrrc, m.limit), BELOW, 0)) for b in range(3)]))
+    for axis in IscAxis:                                                          # seed 3.2.14
+        m = M.SetAlarmIsc.from_phys(channel=int(axis), limit=T.SPU_ALARM_ISC_DEG[int(axis)])
+        out.append(("ISC", m, [(int(axis), AlarmLimit(limit_in(isc, M.SetAlarmIsc, m.limit), BEYOND, 0))]))
+    probes = next(f for f in M.SetAlarmTsc.FIELDS if f.name == "channel").conv
+    for ch in range(probes.lo, probes.hi + 1):                                   # seed 3.2.15
+        m = M.SetAlarmTsc.from_phys(channel=ch, limit=T.SPU_ALARM_TSC_C)
+        out.append(("TSC", m, [(ch, AlarmLimit(limit_in(tsc, M.SetAlarmTsc, m.limit), ABOVE, 0))]))
+    m = M.SetAlarmLsc.from_phys(limit=T.SPU_ALARM_LSC_LX)                         # seed 3.2.16
+    out.append(("LSC", m, [(0, AlarmLimit(limit_in(lsc, M.SetAlarmLsc, m.limit), ABOVE, 0))]))
+    m = M.SetAlarmPsc.from_phys(limit=T.SPU_ALARM_PSC_V)                          # seed 3.2.17
+    out.append(("PSC", m, [(0, AlarmLimit(limit_in(psc, M.SetAlarmPsc, m.limit), BELOW, 0))]))
+    return out
+
+
+class SPU(PostMaster, AfterReplies, SpuSkeleton):
     def start(self) -> None:
         self.sensors = {NODES[a][1]: a for a in slaves_of(self.master_bus)}
-        self.outbox: list[tuple[int, int]] = []
-        self.last_fwd: dict[str, tuple[float, int]] = {}
-        self.cycle_i = 0
         self.live: list[str] = []
-        self.last_record: tuple[int, int] | None = None
+        self.status: dict[str, int] = {}
+        self.misses: dict[str, int] = {}
+        self.free_run: set[str] = set()
+        self.limits: dict[tuple[str, int], AlarmLimit] = {}
+        self.outbox: list[tuple[int, int, int, int]] = []          # (source, kind, channel, value)
+        self.last_fwd: dict[tuple[str, int], tuple[float, int]] = {}
+        self.last_record: tuple[int, int, int, int] | None = None
+        self.requested_at: float | None = None
+        self.posting = False
+        self.polling = False
+        self.cycle_i = self.status_i = 0
+        self.next_status = 0.0
+        self.counts = {"value": 0, "alarm": 0, "status": 0, "ignored": 0, "silent": 0, "untrusted": 0}
+        self.values: dict[str, int] = {}
         self.run_post(self.post_done)
 
-    def post_done(self, missing: list[int]) -> None:
-        self.live = [r for r in T.SPU_CYCLE if r in self.sensors and self.sensors[r] not in missing]
-        if "USRC" in self.live:
-            self.request(self.sensors["USRC"], M.FreeRun())
-        self.poll()
+    # --- POST and set-up ---------------------------------------------------------------
+    def run_post(self, done: Any = None) -> None:
+        self.posting = True            # the poll loop pauses: POST needs the bus to itself at the end
+        super().run_post(done)
 
+    def post_status(self, a: int, msg: M.Message) -> None:
+        """A sensor's STATUS_ACK during POST updates what the SPU knows of it."""
+        if a in NODES and NODES[a][1] in STATUS_OF:
+            self.set_status(NODES[a][1], msg.status)       # type: ignore[attr-defined]
+
+    def post_done(self, missing: list[int]) -> None:
+        self.posting = False
+        self.live = [r for r, a in self.sensors.items() if a not in missing]
+        # seed 3.2.13-3.2.17: the SPU sets up the alarm limits of every sensor present
+        for role, msg, limits in alarm_setup():
+            if role in self.live:
+                self.request(self.sensors[role], msg)
+                self.limits.update({(role, ch): lim for ch, lim in limits})
+        if "USRC" in self.live:        # seed 3.2.11: the sonar scans on its own and announces data
+            self.free_run.add("USRC")
+            self.request(self.sensors["USRC"], M.FreeRun())
+        if not self.polling:
+            self.polling = True
+            self.poll()
+
+    # --- polling -------------------------------------------------------------------------
     def poll(self) -> None:
-        if not self.live:
+        if self.posting:
+            self.polling = False
             return
-        role = self.live[self.cycle_i % len(self.live)]
+        ranged = [r for r in RANGE if r in self.live]
+        if ranged and self.now >= self.next_status:         # seed 6.2: the range sensors' status, in turn
+            self.next_status = self.now + T.SPU_STATUS_EVERY_S
+            role = ranged[self.status_i % len(ranged)]
+            self.status_i += 1
+            self.request(self.sensors[role], M.StatusReq(), (STATUS_OF[role],),
+                         lambda s, m, role=role: (self.set_status(role, m.status), self.answered(role), self.poll()),
+                         lambda role=role: (self.missed(role), self.poll()))
+            return
+        cycle = [r for r in T.SPU_CYCLE if r in self.live]
+        if not cycle:
+            self.hw.after(T.SPU_STATUS_EVERY_S, self.poll)
+            return
+        role = cycle[self.cycle_i % len(cycle)]
         self.cycle_i += 1
         self.request(self.sensors[role], M.XmitData(), (REPLY_OF[role],),
-                     lambda s, msg, role=role: self.got(role, msg, True), self.poll, 0)
+                     lambda s, m, role=role: (self.got(role, m, False), self.poll()),
+                     lambda role=role: (self.missed(role), self.poll()))
+
+    def answered(self, role: str) -> None:
+        self.misses[role] = 0
+
+    def missed(self, role: str) -> None:
+        """No answer even after the spec's retry; SPU_SILENT_POLLS in a row: the sensor is OUT_OF_ORDER."""
+        self.misses[role] = self.misses.get(role, 0) + 1
+        if self.misses[role] >= T.SPU_SILENT_POLLS:
+            if self.status.get(role, _IN_ORDER) != _OUT_OF_ORDER:
+                self.counts["silent"] += 1
+            self.set_status(role, _OUT_OF_ORDER)
 
     def on_data_rdy(self, src: int, msg: M.DataRdy) -> None:
         role = NODES[src][1]
-        if role in REPLY_OF:
+        if role not in REPLY_OF or role not in self.live:
+            return
+        if role in self.free_run:
+            if self.status.get(role, _IN_ORDER) != _IN_ORDER:
+                self.counts["ignored"] += 1       # seed 6.2: an untrustworthy sensor's data is ignored
+                return
             self.request(src, M.XmitData(), (REPLY_OF[role],), lambda s, m, role=role: self.got(role, m, False),
-                         urgent=True)
+                         lambda role=role: self.missed(role), urgent=True)
+            return
+        event = role != "TPSC"                     # anything else announces an alarm or a status change
+        self.request(src, M.XmitData(), (REPLY_OF[role],), lambda s, m, role=role: self.got(role, m, event),
+                     lambda role=role: self.missed(role), urgent=True)
+        if role in RANGE:                          # urgent: goes before the XMIT_DATA just queued
+            self.request(src, M.StatusReq(), (STATUS_OF[role],), lambda s, m, role=role: self.set_status(role, m.status),
+                         lambda role=role: self.missed(role), urgent=True)
 
-    def got(self, role: str, msg: M.Message, polled: bool) -> None:
-        if role == "TPSC":
-            self.forward(role, msg.contact)
-        elif role == "IRRC":
-            v = min(msg.left, msg.center, msg.right)
-            last = self.last_fwd.get(role)
-            if last is None or abs(last[1] - v) >= T.SPU_IR_CHANGE_RAW:
-                self.forward(role, v)
-        elif role in T.SPU_FORWARD_EVERY_S:
-            last = self.last_fwd.get(role)
-            if last is None or self.now - last[0] >= T.SPU_FORWARD_EVERY_S[role]:
-                self.forward(role, msg.brightness if role == "LSC" else msg.distance)
-        if polled:
-            self.poll()
+    # --- what the sensors said -------------------------------------------------------------
+    def set_status(self, role: str, code: int) -> None:
+        old = self.status.get(role, _IN_ORDER)
+        self.status[role] = code
+        if code == old:
+            return
+        self.hw.note("sensor_status_change", node=role, status=code)
+        self.record(role, _STATUS, 0, code)       # seed 6.2: the NP3 (and the MCP on the way) learn it
 
-    def forward(self, role: str, value: int) -> None:
-        self.last_fwd[role] = (self.now, value)
+    def got(self, role: str, msg: M.Message, event: bool) -> None:
+        self.answered(role)
+        if role not in RANGE and self.status.get(role, _IN_ORDER) == _OUT_OF_ORDER:
+            self.set_status(role, _IN_ORDER)       # it answers again
+        if role in RANGE and self.status.get(role, _IN_ORDER) != _IN_ORDER:
+            self.counts["ignored"] += 1            # seed 6.2: not trustworthy, its data is ignored
+            return
+        change, refresh = T.SPU_FORWARD.get(role, (0, 0.0))
+        for ch, v in channels(role, msg).items():
+            lim = self.limits.get((role, ch))
+            if event and lim is not None and lim.beyond(v):
+                self.last_fwd[(role, ch)] = (self.now, v)
+                self.record(role, _ALARM, ch, v)   # the limit set with SET_ALARM was crossed
+                continue
+            last = self.last_fwd.get((role, ch))
+            changed = change is not None and last is not None and abs(v - last[1]) >= max(change, 1)
+            if last is None or changed or self.now - last[0] >= refresh:
+                self.last_fwd[(role, ch)] = (self.now, v)
+                self.record(role, _VALUE, ch, v)
+
+    # --- records to the NP3 through the MCP (seed 3.2.2) -----------------------------------
+    def record(self, role: str, kind: int, channel: int, value: int) -> None:
         src = self.sensors[role]
-        self.outbox = [(a, v) for a, v in self.outbox if a != src] + [(src, value)]
-        if len(self.outbox) == 1:
-            self.slave_send(ADDRESS_OF["MCP"], M.XmitReq())
+        rec = (src, kind, channel, value & 0xFF)             # signed values as their two's complement byte
+        self.counts[_KIND_NAME[kind]] += 1
+        if kind != _STATUS:
+            self.values[role] = self.values.get(role, 0) + 1
+            if role in RANGE and self.status.get(role, _IN_ORDER) != _IN_ORDER:
+                self.counts["untrusted"] += 1                # must stay 0 (6.2): checked by the scenarios
+        if kind == _VALUE and role != "TPSC":                # a newer value replaces one still waiting
+            self.outbox = [r for r in self.outbox if not (r[1] == _VALUE and r[0] == src and r[2] == channel)]
+            self.outbox.append(rec)
+        else:                                     # alarms, status changes and contacts go first (5.2)
+            i = next((i for i, r in enumerate(self.outbox) if r[1] == _VALUE), len(self.outbox))
+            self.outbox.insert(i, rec)
+        if self.requested_at is None:
+            self.ask_bus()
+
+    def ask_bus(self) -> None:
+        self.requested_at = self.now
+        self.slave_send(ADDRESS_OF["MCP"], M.XmitReq())
+        self.hw.after(T.SPU_XMIT_RETRY_S, self._ask_again, self.requested_at)
+
+    def _ask_again(self, asked: float) -> None:
+        if self.outbox and self.requested_at == asked:      # no grant since: the request may be lost
+            self.ask_bus()
 
     def on_xmit_grant(self, src: int, msg: M.XmitGrant) -> None:
         np3 = ADDRESS_OF["NP3"]
+        self.requested_at = None
         if not self.outbox:
             if self.last_record is not None:   # a repeated grant: the record did not get through
-                source, value = self.last_record
-                self.send(src, M.XmitRecord(target=np3, source=source, kind=0, channel=0, value=value))
+                source, kind, ch, value = self.last_record
+                self.send(src, M.XmitRecord(target=np3, source=source, kind=kind, channel=ch, value=value))
             return
-        source, value = self.outbox.pop(0)
-        self.last_record = (source, value)
-        self.send(src, M.XmitRecord(target=np3, source=source, kind=0, channel=0, value=value))
+        self.last_record = source, kind, ch, value = self.outbox.pop(0)
+        self.send(src, M.XmitRecord(target=np3, source=source, kind=kind, channel=ch, value=value))
         if self.outbox:
-            self.slave_send(src, M.XmitReq())
+            self.ask_bus()
+
+    def debug_metrics(self) -> dict:
+        """Records forwarded per kind, data ignored (6.2), sensors declared silent, and the status of each."""
+        return {"records": {k: self.counts[k] for k in ("value", "alarm", "status")},
+                "ignored": self.counts["ignored"], "silent": self.counts["silent"],
+                "untrusted_values": self.counts["untrusted"], "values": dict(sorted(self.values.items())),
+                "status": {r: self.status.get(r, _IN_ORDER) for r in self.live},
+                "posts": self.post_runs}

@@ -19,20 +19,17 @@ fires in a step pre-empts the task in that same step (5.2: react within about
 layer held the actuator (for the NP3: the MOVE command to the MMC) and for how
 long. Pure logic: the clock is injected, nothing here imports the simulator.
 
-`np3_network()` builds the NP3's network: level 0 reflexes (whisker or IR
-contact, pit, dangerous tilt, low battery, blocked leg, unreliable IR),
-level 1 obstacle avoidance, level 2 the current task. The seed puts the fast
-reactions on the lowest level and lets them interrupt navigation (5.2), so the
-suppression wires run from the reflexes towards the task; the mechanism is
-Brooks', only the direction of the wires is the seed's.
+The NP3's own network (reflexes, avoidance, task) is declared in
+behaviours.np3_layers. The seed puts the fast reactions on the lowest level
+and lets them interrupt navigation (5.2), so the suppression wires run from
+the reflexes towards the task; the mechanism is Brooks', only the direction
+of the wires is the seed's.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 from typing import Any, Callable, Mapping, Protocol
-
-from arachnae_proto.enums import MovCmd, TpscContact
 
 Clock = Callable[[], float]
 Outputs = Mapping[str, Any]
@@ -88,10 +85,11 @@ class ReflexModule:
 
     While the plan runs, new triggers do not restart it (the reflex finishes
     its manoeuvre); after it ends a still-present trigger starts it again.
+    The trigger gets the input registers and the time.
     """
 
     def __init__(self, name: str, layer: str, inputs: tuple[str, ...],
-                 trigger: Callable[[Mapping[str, Any]], list[tuple[float, Any]] | None],
+                 trigger: Callable[[Mapping[str, Any], float], list[tuple[float, Any]] | None],
                  output: str = "move") -> None:
         self.name, self.layer, self.inputs, self.outputs = name, layer, inputs, (output,)
         self.trigger = trigger
@@ -101,7 +99,7 @@ class ReflexModule:
         if self.plan is not None and self.plan.value(now) is None:
             self.plan = None
         if self.plan is None:
-            steps = self.trigger(inputs)
+            steps = self.trigger(inputs, now)
             if steps:
                 self.plan = Plan(steps, now)
         value = self.plan.value(now) if self.plan else None
@@ -171,6 +169,11 @@ class ControlTrace:
         for iv in self.intervals(until):
             out[iv.layer] = out.get(iv.layer, 0.0) + iv.duration
         return out
+
+    def switches(self, until: float | None = None) -> int:
+        """How often control passed from one layer to another."""
+        ivs = self.intervals(until)
+        return sum(1 for a, b in zip(ivs, ivs[1:]) if a.layer != b.layer)
 
     def table(self, until: float | None = None) -> str:
         rows = [f"{'start s':>9} {'end s':>9} {'layer':<12} module"]
@@ -352,171 +355,13 @@ class Network:
 
 
 # --------------------------------------------------------------------------- the NP3's network
-_STOP, _FORWARD, _BACKWARD = MovCmd.STOP, MovCmd.FORWARD, MovCmd.BACKWARD
-_LEFT, _RIGHT = MovCmd.TURN_LEFT, MovCmd.TURN_RIGHT
-
-REFLEXES, AVOIDANCE, TASK = "reflexes", "avoidance", "task"
-TASKS = ("forward", "explore", "wall_follow", "seek_light", "avoid_light", "idle")
-
-
-@dataclass(frozen=True)
-class Tuning:
-    """Thresholds and time constants of the NP3 network (CHOICE: the seed names the reactions, not numbers)."""
-
-    contact_back_s: float = 1.6          # back off one tripod cycle ...
-    contact_turn_s: float = 3.2          # ... then turn away for two
-    ir_contact_m: float = 0.06           # IR echo this close counts as contact
-    pit_back_s: float = 3.2              # no ground contact ahead: back off two cycles
-    tilt_limit_deg: float = 30.0         # seed 3.2.14: ISC measures -60..+60 deg
-    tilt_back_s: float = 1.6
-    battery_low_v: float = 4.4           # seed 3.2.17: PSC 4.2..5.0 V; under-voltage stops the robot
-    leg_blocked_hold_s: float = 0.8      # seed 6.1: let the LCP retract the leg and re-plan
-    avoid_m: float = 0.5                 # obstacle within this (IR or US ahead) -> turn away
-    avoid_turn_s: float = 1.6
-    reflex_hold_s: float = 0.5           # suppressor time constants
-    avoid_hold_s: float = 0.5
-    explore_every_s: float = 20.0
-    explore_turn_s: float = 1.6
-    wall_near_m: float = 0.04            # wall following on the right IR beam: keep between near ...
-    wall_far_m: float = 0.09             # ... and far
-    light_check_s: float = 4.0
-
-
-def _hold(value: Any, seconds: float) -> list[tuple[float, Any]]:
-    return [(seconds, value)]
-
-
-def _contact(t: Tuning) -> Callable[[Mapping[str, Any]], list[tuple[float, Any]] | None]:
-    def trigger(i: Mapping[str, Any]) -> list[tuple[float, Any]] | None:
-        left, right = i.get("whiskers") or (False, False)
-        ir = [d for d in (i.get("ir") or ()) if d is not None]
-        if not (left or right or (ir and min(ir) < t.ir_contact_m)):
-            return None
-        away = _RIGHT if left and not right else _LEFT        # seed 3.2.12: OBJ_LEFT -> turn right
-        return [(t.contact_back_s, _BACKWARD), (t.contact_turn_s, away)]
-    return trigger
-
-
-def whiskers_from_tpsc(value: int) -> tuple[bool, bool]:
-    """seed 3.2.12: TPSC data byte -> (left, right) contact."""
-    both = bool(value & TpscContact.OBJ_BOTH)
-    return both or bool(value & TpscContact.OBJ_LEFT), both or bool(value & TpscContact.OBJ_RIGHT)
-
-
-def _avoid(t: Tuning) -> Callable[[Mapping[str, Any]], list[tuple[float, Any]] | None]:
-    def trigger(i: Mapping[str, Any]) -> list[tuple[float, Any]] | None:
-        ir = i.get("ir") or (None, None, None)
-        sonar = i.get("sonar_ahead_m")
-        near = [d for d in ir if d is not None and d < t.avoid_m]
-        if not near and not (sonar is not None and sonar < t.avoid_m):
-            return None
-        left, right = (ir[0] if len(ir) > 0 else None), (ir[-1] if len(ir) > 1 else None)
-        turn = _RIGHT if (left or math.inf) < (right or math.inf) else _LEFT
-        return [(t.avoid_turn_s, turn)]
-    return trigger
-
-
-class TaskModule:
-    """Level 2: the current task (decision 8: wall following, seeking / avoiding light, exploring)."""
-
-    def __init__(self, task: str, t: Tuning) -> None:
-        if task not in TASKS:
-            raise ValueError(f"unknown task {task!r}; one of {TASKS}")
-        self.name, self.layer, self.task, self.t = "task", TASK, task, t
-        self.inputs, self.outputs = ("ir", "light"), ("move",)
-        self.turn_until = -math.inf
-        self.next_check = -math.inf
-        self.last_light: float | None = None
-        self.next_turn: float | None = None
-
-    def step(self, inputs: Mapping[str, Any], now: float) -> Outputs:
-        if now < self.turn_until:
-            return {"move": _LEFT}
-        return {"move": getattr(self, f"_{self.task}")(inputs, now)}
-
-    def _idle(self, i: Mapping[str, Any], now: float) -> MovCmd:
-        return _STOP
-
-    def _forward(self, i: Mapping[str, Any], now: float) -> MovCmd:
-        return _FORWARD
-
-    def _explore(self, i: Mapping[str, Any], now: float) -> MovCmd:
-        if self.next_turn is None:
-            self.next_turn = now + self.t.explore_every_s
-        if now >= self.next_turn:                   # a new heading every so often
-            self.next_turn = now + self.t.explore_every_s
-            self.turn_until = now + self.t.explore_turn_s
-            return _LEFT
-        return _FORWARD
-
-    def _wall_follow(self, i: Mapping[str, Any], now: float) -> MovCmd:
-        ir = i.get("ir") or (None, None, None)
-        right = ir[-1] if ir else None
-        if right is None or right > self.t.wall_far_m:
-            return _RIGHT            # lost the wall on the right: turn towards it
-        if right < self.t.wall_near_m:
-            return _LEFT
-        return _FORWARD
-
-    def _seek_light(self, i: Mapping[str, Any], now: float) -> MovCmd:
-        return self._light(i, now, better=lambda new, old: new >= old)
-
-    def _avoid_light(self, i: Mapping[str, Any], now: float) -> MovCmd:
-        return self._light(i, now, better=lambda new, old: new <= old)
-
-    def _light(self, i: Mapping[str, Any], now: float, better: Callable[[float, float], bool]) -> MovCmd:
-        light = i.get("light")
-        if light is not None and now >= self.next_check:
-            self.next_check = now + self.t.light_check_s
-            if self.last_light is not None and not better(light, self.last_light):
-                self.turn_until = now + self.t.contact_back_s     # getting worse: turn for a while
-                self.last_light = light
-                return _LEFT
-            self.last_light = light
-        return _FORWARD
-
-
-def np3_network(clock: Clock, task: str = "forward", tuning: Tuning | None = None) -> Network:
-    """The NP3's layered network (decision 8); its actuator "move" is the Mov_Cmd for the MMC (3.2.3).
-
-    Sensors (set with `net.sense(...)`): whiskers (left, right) bools;
-    ir (left, centre, right) m or None; ir_unreliable bool; no_ground bool;
-    tilt (longitudinal, transverse) deg; battery_v V; leg_blocked bool;
-    sonar_ahead_m m or None; light (any monotone unit).
-    """
-    t = tuning or Tuning()
-    net = Network(clock)
-    # level 0: reflexes (5.2: fast reactions on the lowest level; 6: faults)
-    reflexes = [
-        ReflexModule("leg_blocked", REFLEXES, ("leg_blocked",),     # seed 6.1: leg blocked -> hold still
-                     lambda i: _hold(_STOP, t.leg_blocked_hold_s) if i.get("leg_blocked") else None),
-        ReflexModule("contact", REFLEXES, ("whiskers", "ir"), _contact(t)),   # seed 3.2.12, 3.2.13
-        ReflexModule("pit", REFLEXES, ("no_ground",),               # seed 1.2.2 sole switch: no ground ahead
-                     lambda i: _hold(_BACKWARD, t.pit_back_s) if i.get("no_ground") else None),
-        ReflexModule("tilt", REFLEXES, ("tilt",),                   # seed 3.2.14: dangerous inclination
-                     lambda i: _hold(_BACKWARD, t.tilt_back_s)
-                     if max(map(abs, i.get("tilt") or (0.0,))) > t.tilt_limit_deg else None),
-        ReflexModule("battery", REFLEXES, ("battery_v",),           # seed 3.2.17: under-voltage -> stop
-                     lambda i: _hold(_STOP, 0.1) if (i.get("battery_v") or math.inf) < t.battery_low_v else None),
-        ReflexModule("ir_unreliable", REFLEXES, ("ir_unreliable",),  # seed 6.2: IR unreliable -> stop
-                     lambda i: _hold(_STOP, 0.1) if i.get("ir_unreliable") else None),
-    ]
-    avoid = ReflexModule("avoid", AVOIDANCE, ("ir", "sonar_ahead_m"), _avoid(t))
-    task_module = TaskModule(task, t)
-    for m in (task_module, avoid, *reflexes):
-        net.add(m)
-    for m in net.modules.values():
-        for p in m.inputs:
-            net.wire(f"sensor.{p}", f"{m.name}.{p}")
-    move = net.actuator("move")
-    net.wire("task.move", move)
-    net.suppress("avoid.move", move, t.avoid_hold_s)          # seed 5.2: collision handling interrupts navigation
-    for r in reflexes:                                        # later reflexes sit closer to the MMC and win
-        net.suppress(f"{r.name}.move", move, t.reflex_hold_s)
-    return net
+def np3_network(clock: Clock, task: str = "forward", tuning: Any = None) -> Network:
+    """The NP3's layered network, declared in behaviours.np3_layers (kept there: its layers and tasks)."""
+    from behaviours.np3_layers import np3_network as build
+    return build(clock, task, tuning)
 
 
 __all__ = [
-    "Behaviour", "FunctionModule", "ReflexModule", "TaskModule", "Network", "ControlTrace", "Interval",
-    "Tuning", "np3_network", "whiskers_from_tpsc", "NONE_LAYER", "REFLEXES", "AVOIDANCE", "TASK", "TASKS",
+    "Behaviour", "FunctionModule", "ReflexModule", "Plan", "Network", "ControlTrace", "Interval", "np3_network",
+    "NONE_LAYER",
 ]

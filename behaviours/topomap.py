@@ -104,6 +104,16 @@ class OccupancyGrid:
         self.logodds[k] = max(-self.limit, min(self.limit, self.logodds[k] + delta))
         self.seen[k] = 1
 
+    def mark_free(self, x: float, y: float, radius_m: float) -> None:
+        """The robot stands here: the cells under its body are free (and seen)."""
+        i0, j0 = self.cell(x - radius_m, y - radius_m)
+        i1, j1 = self.cell(x + radius_m, y + radius_m)
+        for j in range(max(0, j0), min(self.ny, j1 + 1)):
+            for i in range(max(0, i0), min(self.nx, i1 + 1)):
+                cx, cy = self.centre(i, j)
+                if math.hypot(cx - x, cy - y) <= radius_m:
+                    self._bump(i, j, self.miss)
+
     def integrate(self, r: Reading, max_range_m: float = USRC_MAX_RANGE_M) -> None:
         """Free cells along the beam, an occupied cell at the echo (none without an echo).
 
@@ -198,11 +208,18 @@ class TopoMap:
     # -- building -------------------------------------------------------------------
     def add_scan(self, readings: Iterable[Reading]) -> None:
         """Integrate one scan and adapt the graph to it."""
-        for r in readings:
-            if not self.path or self.path[-1] != (r.x, r.y):
-                self.path.append((r.x, r.y))
-            self.grid.integrate(r)
+        self.add(readings)
         self.rebuild()
+
+    def add(self, readings: Iterable[Reading]) -> None:
+        """Integrate readings without rebuilding the graph (single echoes arrive one by one)."""
+        for r in readings:
+            self.visit(r.x, r.y)
+            self.grid.integrate(r)
+
+    def visit(self, x: float, y: float) -> None:
+        if not self.path or self.path[-1] != (x, y):
+            self.path.append((x, y))
 
     def rebuild(self) -> None:
         self.clearance = self._clearance()
@@ -292,10 +309,11 @@ class TopoMap:
                     seen += g.seen[j * g.nx + i]
         return seen / total if total else 0.0
 
-    def frontier(self, x: float, y: float, min_size: int = 5) -> Frontier | None:
+    def frontier(self, x: float, y: float, min_size: int = 5, min_path_m: float = 0.0) -> Frontier | None:
         """The nearest (by free path) cluster of free cells bordering open unknown space; None when explored.
 
-        Clusters smaller than `min_size` cells are gaps between diverging beams, not frontiers.
+        Clusters smaller than `min_size` cells are gaps between diverging beams,
+        not frontiers; cells nearer than `min_path_m` are where the robot already is.
         """
         g = self.grid
         start = g.cell(x, y)
@@ -319,7 +337,7 @@ class TopoMap:
         def is_frontier(c: tuple[int, int]) -> bool:
             return g.state(*c) == FREE and any(open_unknown(c[0] + di, c[1] + dj) for di, dj in _N8)
 
-        cells = {c for c in dist if is_frontier(c)}
+        cells = {c for c in dist if dist[c] >= min_path_m and is_frontier(c)}
         best: Frontier | None = None
         while cells:
             seed = min(cells)

@@ -8,41 +8,161 @@ robot behaves, never what goes on the wire's format.
 """
 from __future__ import annotations
 
-# --- MMC (seed 3.2.4): gait clock and leg polling
+# --- MMC (seed 3.2.4): gait clock, leg polling, errors
 MMC_CONTROL_S = 0.02          # gait generator period
-MMC_POLL_S = 0.1              # one LEG_POLL every 100 ms, legs in turn
+MMC_POLL_S = 0.04             # one LEG_POLL every 40 ms, legs in turn: each leg every 240 ms (a pit within ~0.5 s);
+                              # a poll and its report take ~12 ms of the 19200-baud leg bus
+MMC_LEG_TIMEOUTS = 4          # this many LEG_POLLs in a row unanswered (each with the bus's retry, asked again at
+                              # once): LCP out of order, about 0.2 s after it fell silent
+MMC_HIGH_STEP_S = 6.0         # after a blocked leg every swing lifts to the step limit this long (obstacle underfoot)
+MMC_OVERTEMP_SCALE = 0.5      # a leg reports servo over-temperature: the whole gait runs at half speed
+MMC_LOST_LEG_LIFT_M = 0.06    # a lost leg whose LCP still answers is held this high ...
+MMC_LOST_LEG_TUCK_M = 0.03    # ... and this much closer to the body, out of the way
+
+# --- gait generator (behaviours.gait, runs in the MMC)
+GAIT_OVERRUN = 0.15           # a stance foot may go this fraction of a stroke past its rear end before the body waits
+GAIT_MIN_SWING = 0.5          # a swing never lasts less than half its normal time (late lift-off after a re-phase),
+                              # and is re-aimed at a new direction's touchdown only with at least that much time left
+GAIT_REPHASE_STEPS = 48       # candidate phases tried when fitting a new gait to where the feet are
+GAIT_OVERRUN_WEIGHT = 100.0   # cost of an overrun (per stroke squared) against a merely short or long step
+GAIT_FIVE_LEG_STROKE = 0.5    # five legs: half the stroke, so four feet always hold the body inside their polygon
+GAIT_FIVE_LEG_SPREAD = 0.5    # five legs: the two feet on the lost leg's side stand at +-this x the front hip's x
 
 # --- LCP (seed 3.2.10, 6.1)
 LCP_CONTROL_S = 0.1           # 10 Hz set points per joint, each with the speed to arrive in one period
+LCP_SWING_EDGE = 0.25         # a swing lifts straight up in its first quarter, lowers straight down in its last
 LCP_BLOCK_CURRENT_A = 1.0     # above free-running servo current (0.35 A), below stall (1.8 A): leg blocked
-LCP_SETTLE_S = 0.6            # a stance foot without ground contact this long after touchdown -> no ground
+LCP_SETTLE_S = 0.3            # a carrying foot without sole contact this long (after touchdown): no ground (pit)
+LCP_SET_DOWN_S = 0.15         # a stance target reaching a foot still in the air: it is set down within this time
+LCP_NO_GROUND_Z_M = 0.03      # seed 1.2.2: over a pit the foot hovers this high and carries no weight
 LCP_MIN_SPEED_DEG_S = 30.0    # slowest commanded joint speed: a joint catches up after a lost set point
 LCP_SPEED_MARGIN = 2.0        # commanded speed = this x the speed needed to arrive within one period
 LCP_RETRACT = 0.3             # seed 6.1: a blocked foot goes back this fraction towards its segment start
 LCP_RETRY_MIN_S = 0.2         # shortest retried swing after a block
+LCP_RETRY_GRACE_S = 0.15      # stall current this soon after the retract began is still the first block
 LCP_RETRY_CLEARANCE_M = 0.01  # retried swing lifts this much above the step limit
+LCP_HIGH_STEPS = 3            # after a block the leg's next swings step that high too (the obstacle is still there)
+LCP_JAC_TIMEOUTS = 4          # this many JOINT_POLLs in a row unanswered (each with the bus's retry, asked again at
+                              # the next period): JAC fault
 
 # --- JAC (seed 3.2.18)
-JAC_STALL_CURRENT_A = 1.5     # motor current flagged STALLED | OVERCURRENT
-JAC_AT_TARGET_RAD = 1e-3      # within this of the set point: AT_TARGET
+JAC_CONTROL_S = 0.01          # the servo's position loop runs at 100 Hz on the JAC's timer
+JAC_KP = 40.0                 # 1/s: speed command per radian of position error (time constant 25 ms)
+JAC_DEADBAND_RAD = 1e-3       # closer than this: no drive (below the set point's 0.1 degree resolution)
+JAC_STALL_CURRENT_A = 1.5     # motor current flagged OVERCURRENT
+JAC_STALL_MIN_DRIVE = 0.2     # rad/s: commanded at least this ...
+JAC_STALL_SPEED = 0.02        # ... while the tacho reads less than this ...
+JAC_STALL_S = 0.05            # ... for this long: STALLED (seed 6.1)
+JAC_AT_TARGET_RAD = 2e-3      # within this of the set point and at rest: AT_TARGET
+JAC_OVERTEMP_C = 70.0         # winding temperature flagged OVERTEMP (hobby servo motors are rated ~80 C) ...
+JAC_OVERTEMP_HYST_C = 5.0     # ... until it has cooled this much below the limit
+JAC_WATCHDOG_S = 1.0          # no set point this long (5 refresh periods): the LCP is gone, the servo goes limp
 
-# --- NP3 (seed 3.2.3, 5.1-5.2, decision 8)
-NP3_PERIOD_S = 0.1            # subsumption layers evaluated every 100 ms
-NP3_ESCAPE_BACK_S = 1.6       # back off one tripod cycle
-NP3_ESCAPE_TURN_S = 3.2       # then turn for two cycles
-NP3_IR_NEAR_M = 0.06          # an IR echo closer than this is an obstacle ahead
-NP3_LIGHT_CHECK_S = 4.0       # light gradient check period (seek / avoid light)
-NP3_EXPLORE_EVERY_S = 20      # explore: turn left every 20 s ...
-NP3_EXPLORE_TURN_S = 1.6      # ... for one tripod cycle
+# --- NP3 (seed 3.2.3, 3.3.2, 5.1-5.2, 6, decision 8): the subsumption network's numbers, all CHOICE
+NP3_PERIOD_S = 0.1            # the network is evaluated every 100 ms (5.2: reactions well within 1 s)
+NP3_REFLEX_HOLD_S = 0.5       # suppressor time constants: reflexes ...
+NP3_AVOID_HOLD_S = 0.3        # ... and obstacle avoidance keep the lower layers cut this long
+NP3_CONTACT_BACK_S = 1.6      # contact (whisker, IR very close): back off one tripod cycle ...
+NP3_CONTACT_TURN_S = 2.4      # ... then turn away (about 60 degrees)
+NP3_CONTACT_SIDE_TURN_S = 1.6 # one whisker only, IR clear: just turn away (about 40 degrees)
+NP3_IR_CONTACT_M = 0.03       # an IR echo this close counts as contact
+NP3_AVOID_CENTRE_M = 0.08     # avoidance: the centre beam sees something this close ...
+NP3_AVOID_SIDE_M = 0.06       # ... or a side beam this close -> turn away
+NP3_AVOID_SONAR_M = 0.35      # ... or the sonar, looking ahead (+-15 deg), this close
+NP3_AVOID_TURN_S = 0.8        # one half cycle of turning per avoidance
+NP3_SONAR_AHEAD_DEG = 15      # a sonar reading this close to the body axis counts as "ahead"
+NP3_SONAR_FRESH_S = 1.5       # ... while it is this recent
+NP3_PIT_BACK_S = 2.4          # pit (MMC NO_GROUND): back off ...
+NP3_PIT_TURN_S = 4.8          # ... then turn about 120 degrees
+NP3_TILT_LIMIT_DEG = 25.0     # dangerous inclination (ISC measures -60..60 deg, 3.2.14)
+NP3_TILT_BACK_S = 3.2         # too steep: back off downhill ...
+NP3_TILT_TURN_S = 6.4         # ... and turn around (about 160 degrees)
+NP3_BATTERY_LOW_V = 4.3       # PSC values below this ...
+NP3_BATTERY_LOW_COUNT = 3     # ... this many times in a row (or its ALARM) -> stop for good (3.2.17)
+NP3_LEG_BLOCKED_HOLD_S = 0.8  # blocked leg (6.1): hold still while the LCP retracts and re-plans
+NP3_LEG_BLOCKED_SIDE_S = 0.8  # ... then sidestep this long away from the blocked leg's side
+NP3_AVOID_ECHO_M = 0.35       # avoidance: a remembered echo this far ahead of the body centre ...
+NP3_AVOID_HALF_WIDTH_M = 0.22 # ... within this of the body axis (the legs reach 0.2 m out) -> turn away
+NP3_SOUND_MIN_DEG = 10        # sound straight ahead within this: no turn needed
+NP3_EXPLORE_PLAN_S = 10.0     # explore: a new goal every 10 s (5.2: navigation 10..30 s) or when reached:
+NP3_EXPLORE_HEADINGS = 16     # ... the best of this many headings round the robot, scored on the map by
+NP3_EXPLORE_REACH_M = 3.0     # ... the cells not yet passed along the ray, up to this far, before an obstacle;
+NP3_EXPLORE_MARGIN_M = 0.5    # ... the goal stays this far short of the obstacle
+NP3_EXPLORE_GOAL_M = 2.0      # ... and at most this far away
+NP3_EXPLORE_SEEN_M = 0.5      # ... cells within this of the path count as passed
+NP3_EXPLORE_WANDER_S = 12.0   # explore without a goal: a new heading every 12 s ...
+NP3_EXPLORE_TURN_S = 2.4      # ... turning this long
+NP3_GOAL_REACHED_M = 0.4      # a goal this close (dead reckoning) is reached
+NP3_HEADING_TOL_DEG = 20.0    # steering: turn on the spot while the goal is further off the axis than this
+NP3_WALL_SEEK_FWD_S = 1.6     # wall following (right-hand wall): walk this long ...
+NP3_WALL_SEEK_TURN_S = 0.8    # ... then turn right this long, until the right/centre IR beam sees the wall,
+NP3_WALL_AWAY_S = 1.6         # ... then turn left this long
+NP3_WALL_SEEN_M = 0.09        # an IR echo nearer than this is the wall
+NP3_LIGHT_SAMPLES = 8         # light gradient: plane fitted through this many (pose, log lux) samples
+NP3_LIGHT_MIN_SPREAD_M = 0.25 # ... spread at least this far in both directions
+NP3_LIGHT_PROBE_S = 6.0       # without a gradient: walk this long, then turn a quarter
+NP3_MAP_SIZE_M = 12.0         # topological map: a square this wide around the start ...
+NP3_MAP_CELL_M = 0.1          # ... in cells this wide
+NP3_SONAR_BEAM_DEG = 15.0     # width a sonar echo is spread over on the map (40 kHz transducer cone)
+NP3_DR_SPEED_M_S = 0.09       # dead reckoning: forward / backward speed (bench: the gait's nominal 0.1 m/s
+NP3_DR_SIDE_M_S = 0.083       # ... loses ~10 % re-phasing), sidestep speed,
+NP3_DR_TURN_DEG_S = 22.5      # ... and turn rate on the spot (nominal 25 deg/s), all measured in sim2d
+NP3_ECHO_KEEP_S = 10.0        # local memory: sonar / IR / whisker echoes at the dead-reckoned pose kept this long
+NP3_ECHO_NEAR_M = 1.5         # ... sonar echoes nearer than this only (the map keeps the rest)
+NP3_BODY_FRONT_M = 0.15       # sensor mounts as the NP3 knows them: IR and whiskers at the body's front (CHOICE),
+NP3_IR_BEAM_DEG = 15.0        # ... the IR side beams at +-15 deg (seed 3.2.13),
+NP3_WHISKER_DEG = 25.0        # ... the whiskers 25 deg outward (CHOICE) ...
+NP3_WHISKER_M = 0.10          # ... and 10 cm long (seed 1.2.2)
+NP3_WALL_TARGET_M = 0.30      # wall following: body centre to the right-hand wall (feet reach 0.2 m sideways) ...
+NP3_WALL_DEADBAND_M = 0.05    # ... corrected by a sidestep when off by more than this
+NP3_WALL_CORNER_M = 0.45      # ... a wall ahead this close (centre) is a corner: turn left
+NP3_WALL_ALIGN_DEG = 6.0      # ... the wall's fitted direction this far off the heading: turn to align
+NP3_WALL_LOST_S = 8.0         # ... no wall beside for this long: turn right to find it again
 
-# --- SPU (seed 3.2.5): polling order and forwarding rate limits to the NP3
-SPU_CYCLE = ("IRRC", "USRC", "IRRC", "LSC", "IRRC", "ISC", "IRRC", "TSC", "IRRC", "PSC")  # IR every 2nd poll (5.2)
-SPU_FORWARD_EVERY_S = {"LSC": 2.0, "USRC": 5.0}   # slowly changing values
-SPU_IR_CHANGE_RAW = 8                             # forward an IR reading when it moved this many steps
+# --- SPU (seed 3.2.5): polling order, status checks, alarms and forwarding rate limits to the NP3 (all CHOICE)
+SPU_CYCLE = ("IRRC", "LSC", "IRRC", "ISC", "IRRC", "TSC", "IRRC", "PSC")  # IR every 2nd poll (5.2); USRC free-runs
+SPU_STATUS_EVERY_S = 0.5      # one STATUS_REQ to a range sensor (USRC, IRRC in turn) this often (6.2)
+SPU_SILENT_POLLS = 1          # failed transactions in a row (each with the retry) before OUT_OF_ORDER: the seed 3.2.2 rule
+SPU_XMIT_RETRY_S = 0.3        # a pending record not granted this long: XMIT_REQ again (the request may be lost)
+SPU_FORWARD = {               # VALUE records per (sensor, channel): (min change in raw steps or None, refresh s)
+    "IRRC": (13, 2.0),        # 0.5 cm, the IR resolution the seed expects in practice (3.2.13)
+    "USRC": (0, 0.0),         # every sector minimum the USRC announces
+    "TPSC": (0, 0.0),         # every contact
+    "ISC": (3, 5.0),          # one 3 degree step (3.2.14)
+    "TSC": (2, 10.0),         # 2 degrees C
+    "LSC": (None, 2.0),       # every 2 s only: the NP3 fits its light gradient over samples spread in space
+    "PSC": (4, 5.0),          # 20 mV
+}
+SPU_ALARM_IRRC_CM = 6.0       # SET_ALARM IRRC: an object closer than this (3.2.13; = NP3's "near")
+SPU_ALARM_ISC_DEG = (15, 15)  # SET_ALARM ISC per axis (longitudinal, transverse): tilt beyond this either way (3.2.14)
+SPU_ALARM_TSC_C = 50          # SET_ALARM TSC, every probe: hotter than this (3.2.15)
+SPU_ALARM_LSC_LX = 500.0      # SET_ALARM LSC: brighter than this (3.2.16)
+SPU_ALARM_PSC_V = 4.4         # SET_ALARM PSC: battery under-voltage below this, a quarter charge at rest (3.2.17)
 
-# --- sensor controllers (seed 3.2.11-3.2.17)
+# --- sensor controllers (seed 3.2.11-3.2.17; all CHOICE: the seed gives no figures)
 USRC_SPREAD_RAW = 8           # 3 sonar readings further apart than ~30 cm are suspect (3.2.11)
 IRRC_SPREAD_RAW = 40          # 3 IR readings further apart than ~1.5 cm are suspect (3.2.13)
 USRC_HEAD_STEP_S = 0.005      # time to turn the head by 1 degree
+USRC_SECTOR_DEG = 10          # free run: announce the nearest echo of each sector this wide (one fetch per degree
+                              # would need more than the 2400-baud sensor bus carries)
+IRRC_MEASURE_S = 0.05         # the IRRC, ISC, TSC, LSC and PSC measure on their own clock (alarms, 3.2.13-3.2.17)
+ISC_MEASURE_S = 0.2
+TSC_MEASURE_S = 1.0           # all probes
+LSC_MEASURE_S = 0.2           # the value sent is the mean of the last three (3.2.16)
+PSC_MEASURE_S = 0.5           # the value sent is the mean of the last three (3.2.17)
+ALARM_REARM_RAW = {"IRRC": 26, "ISC": 3, "TSC": 2, "LSC": 6, "PSC": 4}   # hysteresis: an alarm re-arms once the
+                              # value is back this many raw steps inside the limit (1 cm, 3 deg, 2 C, 20 %, 20 mV)
+SENSOR_DATA_RDY_RETRY_S = 1.0 # a DATA_RDY nobody fetched is repeated after this long (a lost frame)
 IRRC_NEAR_M = 0.06            # telemetry only: a new object this close ahead is a stimulus (5.2 latency)
 TPSC_SCAN_S = 0.02            # whisker switch debounce / scan period
+
+# --- MCP (seed 3.2.2, 3.2.17, 6.2, 6.3): supervision (all CHOICE)
+MCP_MMC_POLL_S = 0.25         # STATUS_REQ to the MMC this often: a leg error (pit, blocked leg) reaches the NP3 fast
+MCP_OBSTACLE_SPEAK_S = 10.0   # "Obstacle detected" at most this often
+MCP_LED_BLINK_S = 0.5         # battery under-voltage: the MCP's LED toggles this often (3.2.17)
+
+# --- level-0 nodes (seed 3.2.6-3.2.8, 4.1)
+UIC_KEY_POLL_S = 0.05         # CHOICE: the UIC/RCP reads its RS-232 receive FIFO every 50 ms
+APU_POLL_S = 0.05             # CHOICE: the APU/SDF looks for a new sound event every 50 ms ...
+APU_PROCESS_S = 0.2           # CHOICE: ... and needs this long to find its direction (STATUS BUSY, 3.2.7)
+APU_MIN_LEVEL_DB = 40.0       # CHOICE: quieter events (at the microphones) are not reported

@@ -6,26 +6,22 @@ gesteuert" (seed 4.1). Three small parts:
 
   keymap    key -> message (MOVE with a Mov_Cmd, or POST_REQ); the key table
   screen    LCD lines, last command and alerts -> VT100 bytes
-  terminal  Console: reads keys from a pty / own terminal / serial port, writes the screen
+  terminal  the host's end of the RS-232 line: a pty, the own terminal or a serial port
 
-Interface for the UIC/RCP node behaviour (the simulator attaches one console):
+keymap and screen are pure and used by the UIC/RCP node's firmware
+(behaviours.level0.UIC_RCP), which reads the keys and decides; the terminal
+module only carries bytes between a running simulation and the operator:
 
-    console = attach("pty")            # or "stdio", or a pyserial URL / device
-    print("connect a terminal to", console.peer)
-    ...
-    for msg in console.poll():         # every control period: MOVE / POST_REQ to send (3.2.2:
-        ...                            #   XMIT_REQ, then the record when the MCP grants the bus)
-    console.handle(lcd_text_msg)       # on LCD_TEXT / UIC_ALERT from the MCP, or directly:
-    console.show_lcd(0, "POST OK")     # line 0 or 1, 16 characters
-    console.close()                    # restores the terminal
+    arachnae sim run scenarios/console_drive.yaml --console pty        # prints /dev/pts/N
+    arachnae sim run scenarios/console_drive.yaml --console stdio
+    arachnae sim run scenarios/console_drive.yaml --console serial:/dev/ttyUSB0
 
-Try it without a robot: `python -m console` (keys in this terminal; Ctrl-C quits).
+`python -m console [stdio|pty|serial:DEV]`: an idle robot in an open room to drive by hand.
 """
 from __future__ import annotations
 
 from console.keymap import HELP, KEYMAP, label_for_key, message_for_key
 from console.screen import Screen
-from console.terminal import Console, FdPort, SerialPort, attach, open_pty
 
-__all__ = ["Console", "Screen", "FdPort", "SerialPort", "attach", "open_pty", "KEYMAP", "HELP",
-           "message_for_key", "label_for_key"]
+# console.terminal (termios, pyserial: host only) is imported where a line is opened, never by the firmware side
+__all__ = ["Screen", "KEYMAP", "HELP", "message_for_key", "label_for_key"]

@@ -1,37 +1,22 @@
-"""`python -m console [stdio|pty|URL]`: the RCP console on its own, showing the frames it would send.
+"""`python -m console [stdio|pty|serial:DEV] [--pace X]`: drive an idle robot in an open room by hand.
 
-Ctrl-C or Ctrl-D quits. Each key's message appears on LCD line 1 as the
-frame UIC/RCP -> MCP the node would put on the first-level bus (hex).
+The whole network is simulated (scenarios/interactive/console.yaml); the
+UIC/RCP node reads your keys from the chosen line. Ctrl-C ends the run.
 """
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
-from arachnae_proto.frame import build
-from arachnae_proto.network import ADDRESS_OF
-
-from console.terminal import attach
-
-QUIT = (3, 4)   # Ctrl-C, Ctrl-D: raw mode delivers them as bytes
+SCENARIO = Path(__file__).resolve().parent.parent / "scenarios" / "interactive" / "console.yaml"
 
 
 def main(argv: list[str]) -> int:
-    console = attach(argv[0] if argv else "stdio")
-    if console.peer:
-        print(f"console on {console.peer}: connect a terminal program to it", file=sys.stderr)
-    console.show_lcd(0, "ARACHNAE II")
-    console.show_lcd(1, "Enter command")      # seed 3.2.6 resident message 4
-    try:
-        while True:
-            keys = console.port.read(0.5)
-            if any(b in QUIT for b in keys):
-                return 0
-            for msg in console.feed(keys):
-                console.show_lcd(1, build(ADDRESS_OF["MCP"], ADDRESS_OF["UIC/RCP"], msg).hex())
-    except KeyboardInterrupt:
-        return 0
-    finally:
-        console.close()
+    from arachnae.cli import main as arachnae_main
+
+    where = argv[0] if argv and not argv[0].startswith("-") else "stdio"
+    rest = argv[1:] if argv and not argv[0].startswith("-") else argv
+    return arachnae_main(["sim", "run", str(SCENARIO), "--console", where, "--out", "sim-out/console", *rest])
 
 
 if __name__ == "__main__":

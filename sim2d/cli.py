@@ -22,6 +22,11 @@ def register(sub: Any) -> None:
     run.add_argument("--gif", action="store_true", help="also write an animation run.gif")
     run.add_argument("--sil", action="append", default=[], metavar="NODE",
                      help="run NODE (e.g. TPSC) as AVR firmware in simavr (software in the loop; `make firmware` first)")
+    run.add_argument("--console", metavar="LINE",
+                     help="a VT100 terminal on the UIC/RCP's RS-232 line (seed 4.1): pty (prints the device to open "
+                          "with screen/picocom), stdio (this terminal) or serial:DEVICE (pyserial); paces the run")
+    run.add_argument("--pace", type=float, metavar="X",
+                     help="keep to the wall clock, X simulated seconds per second (default 1 with --console)")
     run.set_defaults(func=cmd_run)
 
     batch = ssub.add_parser("batch", help="run scenarios x seeds in parallel")
@@ -53,6 +58,24 @@ def _check_file(path: str) -> None:
         raise UserError(f"{path}: no such scenario file")
 
 
+def _open_console(where: str) -> Any:
+    """The host end of the RCP line (console.terminal); a bad device is a one-line error."""
+    from console.terminal import attach
+
+    if where not in ("pty", "stdio") and not where.startswith("serial:"):
+        raise UserError(f"--console: expected pty, stdio or serial:DEVICE, got {where!r}")
+    try:
+        port = attach(where)
+    except (OSError, ValueError) as exc:
+        raise UserError(f"--console {where}: cannot open the line ({exc})") from None
+    except Exception as exc:            # pyserial's SerialException
+        raise UserError(f"--console {where}: cannot open the line ({exc})") from None
+    if where == "pty":
+        print(f"RCP console on {port.peer}: connect a terminal, e.g. `screen {port.peer}` or "
+              f"`picocom {port.peer}`", flush=True)
+    return port
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     from sim2d import runner
 
@@ -63,7 +86,15 @@ def cmd_run(args: argparse.Namespace) -> int:
 
         check_sil_nodes(runner.load_spec_once(), args.sil)
         replace_nodes = {name: sil_factory() for name in args.sil}
-    outcome = runner.run(args.scenario, args.seed, gif=args.gif, replace_nodes=replace_nodes)
+    if args.pace is not None and not args.pace > 0:
+        raise UserError(f"--pace: must be > 0, got {args.pace}")
+    console = _open_console(args.console) if args.console else None
+    try:
+        outcome = runner.run(args.scenario, args.seed, gif=args.gif, replace_nodes=replace_nodes,
+                             console=console, pace=args.pace)
+    finally:
+        if console is not None:
+            console.close()             # restores a raw terminal before anything is printed
     out = runner.write_outputs(outcome, args.out or runner.default_out(outcome), gif=args.gif)
     m = outcome.result.metrics
     print(f"{outcome.scenario.name} seed {outcome.scenario.seed}: POST {m['post']['verdict']}, "

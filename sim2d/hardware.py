@@ -72,10 +72,22 @@ class NodeHardware:
     def sole_contact(self) -> bool:
         return self.sensors.foot_contact(self.leg)
 
+    # --- level-0 peripherals (sim2d.level0_io) ---------------------------------------------
+    def rcp_read(self) -> bytes:
+        return self.sim.rcp.read()
+
+    def rcp_write(self, data: bytes) -> None:
+        if self.alive:
+            self.sim.rcp.write(data)
+
+    def sound_event(self) -> tuple[float, float] | None:
+        return self.sim.microphones.next()
+
     # --- servo ---------------------------------------------------------------------------
-    def set_servo(self, angle: float, speed: float) -> None:
-        self.robot.set_joint_target(self.leg, self.joint, angle, speed)
+    def set_servo_drive(self, speed: float | None) -> None:
+        if self.alive:
+            self.robot.set_joint_drive(self.leg, self.joint, speed)
 
     def servo_state(self) -> ServoState:
         j = self.robot.legs[self.leg].joints[self.joint - 1]
-        return ServoState(j.angle, j.speed, j.current, self.sim.scenario.ambient_temp)
+        return ServoState(j.angle, j.speed, j.current, j.temperature)

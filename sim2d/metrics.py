@@ -27,13 +27,18 @@ def reaction_latencies(stimuli: list[tuple[float, str]], moves: list[tuple[float
     return out
 
 
-def note_counts(notes: list[tuple[float, str, str, dict[str, Any]]]) -> dict[str, dict[str, Any]]:
-    """Per debug-port event: how often, first and last time (behaviours add events without touching sim2d)."""
+def note_counts(notes: list[tuple[float, str, str, dict[str, Any]]],
+                poses: list[tuple[float, float, float, float]] = ()) -> dict[str, dict[str, Any]]:
+    """Per debug-port event: how often, first and last time (behaviours add events without touching sim2d),
+    and how far the robot walked after its first occurrence (e.g. after a fault: did it stop?)."""
     out: dict[str, dict[str, Any]] = {}
     for t, _node, event, _data in notes:
         e = out.setdefault(event, {"count": 0, "first_s": round(t, 6), "last_s": round(t, 6)})
         e["count"] += 1
         e["last_s"] = round(t, 6)
+    for e in out.values():
+        after = [(x, y) for t, x, y, _th in poses if t >= e["first_s"]]
+        e["walked_after_m"] = round(sum(math.dist(a, b) for a, b in zip(after, after[1:])), 4)
     return dict(sorted(out.items()))
 
 
@@ -58,6 +63,9 @@ def lookup(metrics: dict[str, Any], path: str) -> Any:
 
 
 def build_metrics(sim: "Simulation") -> dict[str, Any]:
+    from sim2d.level0_io import rcp_metrics, sound_metrics
+    from sim2d.nav_metrics import nav_metrics
+    from sim2d.gait_metrics import motion_metrics
     from sim2d.sim import trace_hash
     dur = sim.scenario.duration
     buses = {}
@@ -106,8 +114,12 @@ def build_metrics(sim: "Simulation") -> dict[str, Any]:
         "frame_loss": sum(b["lost"] for b in buses.values()),
         "frames_corrupted": sum(b["corrupted"] for b in buses.values()),
         "battery_v": round(sim.robot.battery_voltage(), 3),
-        "notes": note_counts(sim.notes),
+        "notes": note_counts(sim.notes, sim.poses),
+        "sound": sound_metrics(sim),             # sim2d.level0_io: sound events, final heading error
+        "rcp": rcp_metrics(sim),                 # keys typed on the RCP console
         "nodes": node_metrics(sim.nodes, dur),
+        "motion": motion_metrics(sim),           # sim2d.gait_metrics: body-frame motion per (gait, MOVE)
+        **nav_metrics(sim),                      # sim2d.nav_metrics: coverage, wall_band (scenario `measure:`)
         "trace_hash": trace_hash(sim.frames, sim.poses),
     }
 

@@ -6,6 +6,13 @@ transform that best keeps the stance feet on their anchors. The chassis is a
 pymunk shape, used only to detect contact with walls and tall obstacles: a
 move into one is refused (the feet slip). A swing foot that runs into a solid
 taller than itself stops there and its servos draw stall current (seed 6.1).
+
+Servos (seed 3.2.18): the JAC drives each one with a speed command
+(`set_joint_drive`, rad/s, limited by the servo's top speed) and closes the
+position loop itself; `set_joint_target` is a position servo for tests that
+drive the legs without the network. Each servo's winding warms with the
+square of its current and cools towards the air around the robot
+(first-order thermal model, CHOICE constants in RobotParams).
 """
 from __future__ import annotations
 
@@ -31,6 +38,8 @@ class Joint:
     speed: float = 0.0
     powered: bool = True
     rate: float = math.inf      # commanded speed (rad/s); the servo's own limit still applies
+    drive: float | None = None  # speed command from the JAC (rad/s); None: position mode (target, rate)
+    temperature: float = 20.0   # winding temperature, degrees C
 
 
 @dataclass
@@ -79,6 +88,10 @@ class Robot:
             self._update_foot(self.legs[i])
             self.legs[i].contact = True
             self.legs[i].anchor = self.legs[i].world
+        self.ambient = world.temperature(pose[0], pose[1])
+        for leg in self.legs.values():
+            for j in leg.joints:
+                j.temperature = self.ambient
         self.charge_used_ah = 0.0
         self.current = 0.0
         self.body = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
@@ -110,8 +123,27 @@ class Robot:
         return False
 
     def set_joint_target(self, leg: int, joint: int, angle: float, rate: float = math.inf) -> None:
+        """Position mode: the servo runs to `angle` at `rate` (tests driving the legs without JACs)."""
         j = self.legs[leg].joints[joint - 1]
-        j.target, j.rate = angle, rate
+        j.target, j.rate, j.drive = angle, rate, None
+
+    def set_joint_drive(self, leg: int, joint: int, rate: float | None) -> None:
+        """Speed mode (the JAC's output stage): turn at `rate` rad/s; None: no pulses, the servo goes limp."""
+        j = self.legs[leg].joints[joint - 1]
+        if rate is None:
+            j.powered, j.drive = False, 0.0
+        else:
+            j.powered, j.drive = True, rate
+
+    def warm_servos(self, dt: float) -> None:
+        """CHOICE: first-order thermal model, dT/dt = (P * R_th - (T - T_air)) / tau with P = I^2 R."""
+        p = self.p
+        air = self.ambient = self.world.temperature(self.pose[0], self.pose[1])
+        k = dt / p.servo_thermal_tau_s
+        for leg in self.legs.values():
+            for j in leg.joints:
+                rise = j.current * j.current * p.servo_winding_ohm * p.servo_thermal_k_per_w
+                j.temperature += (air + rise - j.temperature) * k
 
     # --- one physics step -----------------------------------------------------
     def step(self, dt: float) -> None:
@@ -131,9 +163,12 @@ class Robot:
             old = [j.angle for j in leg.joints]
             moving = False
             for j in leg.joints:
-                err = j.target - j.angle
-                lim = max_step if j.rate * dt > max_step else j.rate * dt
-                d = err if abs(err) <= lim else math.copysign(lim, err)
+                if j.drive is not None:
+                    d = max(-max_step, min(max_step, j.drive * dt))
+                else:
+                    err = j.target - j.angle
+                    lim = max_step if j.rate * dt > max_step else j.rate * dt
+                    d = err if abs(err) <= lim else math.copysign(lim, err)
                 j.angle += d
                 j.speed = d / dt
                 moving = moving or abs(d) > 1e-9
@@ -173,7 +208,8 @@ class Robot:
             if leg.over_pit and leg.foot[2] <= CONTACT_EPS:
                 self.events.pit_feet += 1
             for j in leg.joints:
-                if leg.blocked and abs(j.target - j.angle) > 1e-6:
+                pushing = abs(j.drive) > 1e-6 if j.drive is not None else abs(j.target - j.angle) > 1e-6
+                if leg.blocked and pushing:
                     j.current = p.servo_stall_a
                 elif abs(j.speed) > 1e-9:
                     j.current = p.servo_move_a
@@ -181,6 +217,7 @@ class Robot:
                     j.current = p.servo_idle_a
                 total_current += j.current
         self._move_body()
+        self.warm_servos(dt)
         self.current = total_current
         self.charge_used_ah += total_current * dt / 3600.0
 

@@ -24,6 +24,9 @@ class RobotParams(RobotGeometry):
     servo_idle_a: float = 0.05            # CHOICE: servo current holding position
     servo_move_a: float = 0.35            # CHOICE: servo current while moving freely
     servo_stall_a: float = 1.8            # CHOICE: stall current when the leg is blocked (seed 6.1)
+    servo_winding_ohm: float = 5.0        # CHOICE: motor winding resistance (heat = I^2 R)
+    servo_thermal_k_per_w: float = 15.0   # CHOICE: winding-to-air thermal resistance: moving (0.35 A) +9 K, stalled +240 K
+    servo_thermal_tau_s: float = 60.0     # CHOICE: thermal time constant: a stalled servo passes 70 C in about 14 s
     electronics_a: float = 0.6            # CHOICE: 39 microcontrollers, sensors, transceivers
     battery_full_v: float = 5.0           # seed 3.2.17: battery window 4.2 .. 5.0 V
     battery_empty_v: float = 4.2          # seed 3.2.17

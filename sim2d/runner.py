@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from sim2d.level0_io import WallClock, attach_console
 from sim2d.metrics import check_expectations
 from sim2d.scenario import Scenario, load_scenario
 from sim2d.sim import Result, Simulation, trace_lines
@@ -21,6 +22,7 @@ class Outcome:
     scenario: Scenario
     result: Result
     expectations: list[tuple[str, bool, str]]
+    rcp_screen: bytes = b""          # what the UIC/RCP drew on its VT100 terminal (sim2d.level0_io)
 
     @property
     def failed(self) -> list[tuple[str, bool, str]]:
@@ -33,14 +35,18 @@ def load_spec_once() -> Any:
 
 
 def run(path: str, seed: int | None = None, spec: Any = None, gif: bool = False,
-        replace_nodes: dict[str, Any] | None = None) -> Outcome:
+        replace_nodes: dict[str, Any] | None = None, console: Any = None, pace: float | None = None) -> Outcome:
+    """`console`: a host terminal line (console.terminal) on the UIC/RCP's RS-232 port; with it, or with
+    `pace` (simulated seconds per wall second), the run keeps to the wall clock."""
     spec = spec or load_spec_once()
     sc = load_scenario(path, spec)
     if seed is not None:
         sc = sc.with_seed(seed)
     sim = Simulation(sc, spec, keep_frames_every=GIF_FRAME_S if gif else None, replace_nodes=replace_nodes)
+    if console is not None or pace is not None:
+        attach_console(sim, console if console is not None else WallClock(), 1.0 if pace is None else pace)
     result = sim.run()
-    return Outcome(sc, result, check_expectations(sc, result.metrics))
+    return Outcome(sc, result, check_expectations(sc, result.metrics), bytes(sim.rcp.screen))
 
 
 def write_outputs(outcome: Outcome, out_dir: str | Path, gif: bool = False) -> Path:
@@ -64,6 +70,10 @@ def write_outputs(outcome: Outcome, out_dir: str | Path, gif: bool = False) -> P
             artifacts = getattr(node, "write_artifacts", None)
             if artifacts is not None:
                 artifacts(tmp)
+        ssc = r.nodes.get("SSC")
+        if outcome.scenario.speech_wav and ssc is not None:   # scenario `speech: {wav: true}`
+            ssc.write_wavs(tmp / "speech")
+        (tmp / "rcp_screen.vt100").write_bytes(outcome.rcp_screen)   # the UIC/RCP's terminal output
         if gif:
             render_gif(r, str(tmp / "run.gif"))
         os.chmod(tmp, 0o755)

@@ -19,8 +19,11 @@ from sim2d.schema import Bool, Dict, Key, List, Map, Num, Point, Polygon, Scalar
 
 TASKS = ("forward", "wall_follow", "seek_light", "avoid_light", "explore", "idle")  # SPEC-NOTES decision 8
 VERDICTS = ("OPERATIONAL", "DEGRADED", "HALTED")                                  # SPEC-NOTES decision 3
-LIST_KEYS = ("walls", "obstacles", "pits", "slopes", "lights", "heat", "sounds", "faults")
-MAP_KEYS = ("arena", "robot", "expect")
+LIST_KEYS = ("walls", "obstacles", "pits", "slopes", "lights", "heat", "sounds", "faults", "operator")
+MAP_KEYS = ("arena", "robot", "expect", "measure", "speech")
+# sensor faults (extra random spread per reading, sim2d.sensors): USRC/IRRC metres, ISC degrees,
+# TSC degrees C, LSC relative, PSC volts
+SENSOR_FAULTS = ("USRC", "IRRC", "ISC", "TSC", "LSC", "PSC")
 
 
 @dataclass(frozen=True)
@@ -57,15 +60,34 @@ class Sound:
 
 
 @dataclass(frozen=True)
+class OperatorKeys:
+    """Keys typed on the UIC/RCP's VT100 console at simulated time `at` (seed 4.1)."""
+
+    at: float
+    keys: str
+
+
+def _rcp_keys_check(keys: str) -> str | None:
+    from console.keymap import KEYMAP        # the RCP's key table (host-side console package)
+    bad = sorted({k for k in keys if k.upper() not in KEYMAP})
+    if not keys:
+        return "give at least one key"
+    if bad:
+        return f"{''.join(bad)!r} is not an RCP key (one of {''.join(sorted(KEYMAP)).strip()} or space)"
+    return None
+
+
+@dataclass(frozen=True)
 class Fault:
     at: float
     until: float | None
-    kind: str                 # kill | mute | bus
+    kind: str                 # kill | mute | bus | sensor
     node: str | None = None
     bus: str | None = None
     loss: float = 0.0
     corrupt: float = 0.0
     delay: float = 0.0
+    noise: float = 0.0        # sensor: extra spread (1 sigma) of every reading, in the sensor's unit
 
 
 @dataclass(frozen=True)
@@ -103,6 +125,11 @@ class Scenario:
     absent: tuple[str, ...]
     faults: tuple[Fault, ...]
     expect: Expectations = field(default_factory=Expectations)
+    measure: dict[str, Any] | None = None    # navigation metrics to compute (sim2d.nav_metrics): coverage, wall_band
+    operator: tuple[OperatorKeys, ...] = ()   # keys typed on the RCP console (seed 4.1)
+    speech_wav: bool = False                   # also write the SSC's utterances as WAV (espeak-ng)
+    battery_charge: float = 1.0                # state of charge at power-on
+    battery_ah: float | None = None            # battery capacity; None: the robot's (sim2d.robot_params)
 
     def with_seed(self, seed: int) -> "Scenario":
         from dataclasses import replace
@@ -110,9 +137,11 @@ class Scenario:
 
 
 def _fault_check(d: dict) -> str | None:
-    kinds = [k for k in ("kill", "mute", "bus") if d[k] is not None]
+    kinds = [k for k in ("kill", "mute", "bus", "sensor") if d[k] is not None]
     if len(kinds) != 1:
-        return "a fault names exactly one of kill, mute or bus"
+        return "a fault names exactly one of kill, mute, bus or sensor"
+    if (kinds[0] == "sensor") != (d["noise"] > 0):
+        return "a sensor fault needs noise > 0" if kinds[0] == "sensor" else "noise belongs to a sensor fault"
     if kinds[0] == "bus" and not (d["loss"] or d["corrupt"] or d["delay"]):
         return "a bus fault needs loss, corrupt or delay"
     if kinds[0] != "bus" and (d["loss"] or d["corrupt"] or d["delay"]):
@@ -150,12 +179,24 @@ def _schemas(spec: Any) -> dict[str, Any]:
             "pose": Key(List(Num(), 3), required=True),
             "task": Key(Str(TASKS), default="forward"),
             "absent": Key(List(node), default=[]),
+            "battery_charge": Key(Num(0.0, 1.0), default=1.0),    # state of charge at power-on (3.2.17)
+            "battery_ah": Key(Num(positive=True, hi=100)),       # capacity: a worn battery drains fast
         }, check=lambda d: None if len(d["pose"]) == 3 else "pose is [x, y, heading_deg]"),
+        "operator": List(Map({"at": Key(Num(0.0), True), "keys": Key(Str(check=_rcp_keys_check), True)})),
+        "speech": Map({"wav": Key(Bool(), default=False)}),
         "faults": List(Map({
             "at": Key(Num(0.0), default=0.0), "until": Key(Num(0.0)),
             "kill": Key(node), "mute": Key(node), "bus": Key(Str(choices=buses)),
             "loss": Key(prob, default=0.0), "corrupt": Key(prob, default=0.0), "delay": Key(Num(0.0, 10.0), default=0.0),
+            "sensor": Key(Str(choices=SENSOR_FAULTS)), "noise": Key(Num(0.0, 100.0), default=0.0),
         }, check=_fault_check)),
+        "measure": Map({     # sim2d.nav_metrics, checked with expect.metrics (coverage.share, wall_band.share)
+            "coverage": Key(Map({"region": Key(Polygon(), True), "radius": Key(Num(positive=True), default=0.5),
+                                 "cell": Key(Num(positive=True), default=0.1)})),
+            "wall_band": Key(Map({"min": Key(Num(0.0), True), "max": Key(Num(positive=True), True),
+                                  "after": Key(Num(0.0), default=0.0)},
+                                 check=lambda d: None if d["max"] > d["min"] else "max must be above min")),
+        }),
         "expect": Map({
             "post": Key(Str(VERDICTS)),
             "no_collision": Key(Bool(), default=False),
@@ -252,9 +293,12 @@ def load_scenario(path: str | Path, spec: Any = None) -> Scenario:
 def _build(v: dict[str, Any], shown: str) -> Scenario:
     arena, robot = v["arena"], v["robot"]
     exp = v.get("expect") or {}
+    measure = v.get("measure") or None
     faults = tuple(
-        Fault(at=f["at"], until=f["until"], kind="kill" if f["kill"] else "mute" if f["mute"] else "bus",
-              node=f["kill"] or f["mute"], bus=f["bus"], loss=f["loss"], corrupt=f["corrupt"], delay=f["delay"])
+        Fault(at=f["at"], until=f["until"],
+              kind="kill" if f["kill"] else "mute" if f["mute"] else "sensor" if f["sensor"] else "bus",
+              node=f["kill"] or f["mute"] or f["sensor"], bus=f["bus"], loss=f["loss"], corrupt=f["corrupt"],
+              delay=f["delay"], noise=f["noise"])
         for f in v.get("faults", [])
     )
     x, y, heading = robot["pose"]
@@ -278,6 +322,7 @@ def _build(v: dict[str, Any], shown: str) -> Scenario:
         task=robot["task"],
         absent=tuple(robot["absent"]),
         faults=faults,
+        measure=measure,
         expect=Expectations(
             post=exp.get("post"), no_collision=bool(exp.get("no_collision")),
             reach=(exp["reach"]["region"], exp["reach"]["within"]) if exp.get("reach") else None,
@@ -286,4 +331,8 @@ def _build(v: dict[str, Any], shown: str) -> Scenario:
             metrics={k: {op: b for op, b in v.items() if b is not None} for k, v in (exp.get("metrics") or {}).items()}
             or None,
         ),
+        operator=tuple(sorted((OperatorKeys(o["at"], o["keys"]) for o in v.get("operator", [])), key=lambda o: o.at)),
+        speech_wav=bool((v.get("speech") or {}).get("wav")),
+        battery_charge=robot["battery_charge"],
+        battery_ah=robot.get("battery_ah"),
     )

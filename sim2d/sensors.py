@@ -8,6 +8,7 @@ them into the spec's wire encodings is the sensor controller's firmware
 from __future__ import annotations
 
 import math
+import random
 from dataclasses import dataclass, field
 
 from sim2d.geometry import Pt, to_world
@@ -31,6 +32,26 @@ class Sensors:
         self.world, self.robot, self.p = world, robot, robot.p
         self.rng = {name: stream(seed, f"sensor:{name}") for name in ("usrc", "irrc", "tsc", "lsc", "isc", "psc")}
         self.log = SensorLog()
+        self.seed = seed
+        self.fault_noise: dict[str, float] = {}      # scenario sensor faults: extra 1-sigma spread per reading
+        self.fault_rng: dict[str, random.Random] = {}
+
+    def set_fault(self, name: str, noise: float) -> None:
+        """A sensor fault (scenario `faults: - {sensor: IRRC, noise: 0.03}`); noise 0 ends it."""
+        key = name.lower()
+        self.fault_noise[key] = noise
+        self.fault_rng.setdefault(key, stream(self.seed, f"fault:{key}"))
+
+    def _extra(self, key: str) -> float:
+        sigma = self.fault_noise.get(key, 0.0)
+        return self.fault_rng[key].gauss(0.0, sigma) if sigma > 0 else 0.0
+
+    def _faulty_range(self, key: str, hit: float | None, top: float) -> float | None:
+        """A faulty range sensor also makes up echoes out of nothing: the spread applies to 'no echo' too."""
+        if self.fault_noise.get(key, 0.0) <= 0:
+            return hit
+        d = (top if hit is None else hit) + self._extra(key)
+        return None if d >= top else max(0.0, d)
 
     # seed 3.2.11: 40 kHz transducer on a head turning 360 deg in 1 deg steps, range 10 m
     def usrc_ping(self, head_deg: int, t: float = 0.0) -> tuple[float | None, float]:
@@ -47,10 +68,10 @@ class Sensors:
             if hit is not None and (best is None or hit[0] < best[0]):
                 best = hit
         if best is None:
-            return None, 2 * p.us_range / p.sound_speed
+            return self._faulty_range("usrc", None, p.us_range), 2 * p.us_range / p.sound_speed
         d = max(0.0, best[0] + self.rng["usrc"].gauss(0.0, p.us_noise_m))
         self.log.sonar.append((t, best[1]))
-        return d, 2 * best[0] / p.sound_speed
+        return self._faulty_range("usrc", d, p.us_range), 2 * best[0] / p.sound_speed
 
     # seed 3.2.13: three IR beams, 0 deg and +-15 deg, range 10 cm
     def irrc(self) -> tuple[float | None, ...]:
@@ -63,11 +84,11 @@ class Sensors:
             a = th + math.radians(deg)
             hit = self.world.ray(origin, a, p.ir_range, p.ir_height)
             if hit is None:
-                out.append(None)
+                out.append(self._faulty_range("irrc", None, p.ir_range))
                 rays.append((origin, (origin[0] + p.ir_range * math.cos(a), origin[1] + p.ir_range * math.sin(a)), False))
             else:
                 d = max(0.0, hit[0] + self.rng["irrc"].gauss(0.0, p.ir_noise_m))
-                out.append(d)
+                out.append(self._faulty_range("irrc", d, p.ir_range))
                 rays.append((origin, hit[1], True))
                 self.log.ir_hits.append((origin, hit[1]))
         self.log.ir_rays = rays
@@ -103,7 +124,8 @@ class Sensors:
 
         def resolve(deg: float) -> float:
             return max(-top, min(top, step * round(deg / step)))
-        return resolve(pitch + r.gauss(0.0, step / 3)), resolve(roll + r.gauss(0.0, step / 3))
+        return (resolve(pitch + r.gauss(0.0, step / 3) + self._extra("isc")),
+                resolve(roll + r.gauss(0.0, step / 3) + self._extra("isc")))
 
     def tilt_deg(self) -> float:
         """True (noise-free) inclination magnitude under the body, for the metrics."""
@@ -118,19 +140,19 @@ class Sensors:
         for ch in range(p.tsc_channels):
             a = 2 * math.pi * ch / p.tsc_channels
             px, py = to_world(self.robot.pose, p.body_length / 2 * math.cos(a), p.body_width / 2 * math.sin(a))
-            out.append(self.world.temperature(px, py) + self.rng["tsc"].gauss(0.0, p.tsc_noise_c))
+            out.append(self.world.temperature(px, py) + self.rng["tsc"].gauss(0.0, p.tsc_noise_c) + self._extra("tsc"))
         return tuple(out)
 
     # seed 3.2.16: logarithmic light sensor on top of the body
     def lsc(self) -> float:
         """Lux at the sensor."""
         lux = self.world.lux(self.robot.pose[0], self.robot.pose[1])
-        return lux * (1.0 + self.rng["lsc"].gauss(0.0, self.p.lsc_noise_rel))
+        return max(0.0, lux * (1.0 + self.rng["lsc"].gauss(0.0, self.p.lsc_noise_rel) + self._extra("lsc")))
 
     # seed 3.2.17: battery voltage
     def psc(self) -> float:
         """Battery volts."""
-        return self.robot.battery_voltage() + self.rng["psc"].gauss(0.0, 0.005)
+        return self.robot.battery_voltage() + self.rng["psc"].gauss(0.0, 0.005) + self._extra("psc")
 
     # seed 3.2.18: position (potentiometer), speed (tacho), plus motor current (seed 6.1)
     def joint(self, leg: int, joint: int) -> tuple[float, float, float]:

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import hashlib
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Callable
 
 from arachnae_proto import CodecError
@@ -28,6 +28,7 @@ from sim2d.bus import Bus, Fault as BusFault, TraceEntry
 from sim2d.events import Scheduler
 from sim2d.geometry import point_in_polygon
 from sim2d.hardware import NodeHardware
+from sim2d.level0_io import Microphones, RcpLine, schedule as schedule_level0_io
 from sim2d.rng import stream
 from sim2d.robot import Robot
 from sim2d.robot_params import DEFAULT, RobotParams
@@ -115,12 +116,17 @@ class Simulation:
                  replace_nodes: dict[str, NodeFactory] | None = None):
         """`replace_nodes` runs some nodes as something else than their Python behaviour, e.g. firmware
         in simavr (`--sil`); such a node's UART hears every frame on its buses."""
+        if scenario.battery_ah is not None:           # the scenario's own battery (3.2.17 under-voltage)
+            params = replace(params, battery_ah=scenario.battery_ah)
         self.scenario, self.spec, self.params = scenario, spec, params
         replace_nodes = replace_nodes or {}
         self.sched = Scheduler()
         self.world = World(scenario)
         self.robot = Robot(params, self.world, scenario.start)
+        self.robot.charge_used_ah = (1.0 - scenario.battery_charge) * params.battery_ah
         self.sensors = Sensors(self.world, self.robot, scenario.seed)
+        self.rcp = RcpLine()                                   # the UIC/RCP's RS-232 line (seed 4.1)
+        self.microphones = Microphones(scenario.seed)          # the APU/SDF's view of `sounds:` (seed 3.2.7)
         self.frames: list[FrameRecord] = []
         self.buses: dict[str, Bus] = {}
         for name, b in spec.buses.items():
@@ -194,7 +200,12 @@ class Simulation:
     # --- faults --------------------------------------------------------------------
     def _schedule_faults(self) -> None:
         for f in self.scenario.faults:
-            if f.kind == "bus":
+            self.sched.at(f.at, self._fault_note, f)
+            if f.kind == "sensor":
+                self.sched.at(f.at, self.sensors.set_fault, f.node, f.noise)
+                if f.until is not None:
+                    self.sched.at(f.until, self.sensors.set_fault, f.node, 0.0)
+            elif f.kind == "bus":
                 self.sched.at(f.at, self._set_bus_fault, f.bus, BusFault(f.loss, f.corrupt, f.delay))
                 if f.until is not None:
                     self.sched.at(f.until, self._set_bus_fault, f.bus, BusFault())
@@ -205,6 +216,10 @@ class Simulation:
                     self.sched.at(f.at, self._mute, f.node, True)
                     if f.until is not None:
                         self.sched.at(f.until, self._mute, f.node, False)
+
+    def _fault_note(self, f: Any) -> None:
+        """The fault's start in the notes (metrics notes.fault_injected: what happened after it)."""
+        self.notes.append((self.sched.now, "sim", "fault_injected", {"kind": f.kind, "node": f.node, "bus": f.bus}))
 
     def _set_bus_fault(self, bus: str, fault: BusFault) -> None:
         self.buses[bus].fault = fault
@@ -262,6 +277,7 @@ class Simulation:
     def run(self) -> Result:
         dur = self.scenario.duration
         self._schedule_faults()
+        schedule_level0_io(self)            # operator keys, sound events
         for proc in self.nodes.values():
             proc.start()                    # power-on: behaviours start their own timers
         self._every(self.params.dt, self._physics)

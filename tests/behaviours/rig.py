@@ -35,7 +35,7 @@ class Board:
         self.whisker = (False, False)
         self.sonar: list = []             # readings returned in turn: (metres or None, tof)
         self.servo = ServoState(0.0, 0.0, 0.05, 20.0)
-        self.servo_set: list[tuple[float, float]] = []
+        self.servo_set: list[tuple[float, float | None]] = []   # (time, speed command) the JAC gave the servo
 
     def now(self) -> float:
         return self.t
@@ -67,8 +67,8 @@ class Board:
     def sonar_ping(self, head_deg: int) -> tuple[float | None, float]:
         return self.sonar.pop(0) if self.sonar else (None, 0.06)
 
-    def set_servo(self, angle: float, speed: float) -> None:
-        self.servo_set.append((angle, speed))
+    def set_servo_drive(self, speed: float | None) -> None:
+        self.servo_set.append((self.t, speed))
 
     def servo_state(self) -> ServoState:
         return self.servo

@@ -9,6 +9,7 @@ from hypothesis import given, settings, strategies as st
 from arachnae_proto import messages as M
 from arachnae_proto.enums import LegFlags, LegPhase
 
+from behaviours import tuning as T
 from behaviours.geometry import DEFAULT_GEOMETRY as G
 from behaviours.kinematics import fk, ik
 from tests.behaviours.rig import Rig
@@ -65,14 +66,14 @@ def jacs_answer(f):
 
 
 def commanded(rig: Rig) -> list[tuple[float, tuple[float, float, float]]]:
-    """The joint angles (rad) the LCP has commanded after each JOINT_TARGET, from the bytes it sent."""
+    """The joint angles (rad) the LCP has commanded, one complete set per control period, from the bytes it sent."""
     q = [None, None, None]
-    out = []
+    out: dict[int, tuple[float, tuple]] = {}
     for t, f in rig.frames(M.JointTarget):
         q[JACS.index(f.dst)] = math.radians(f.message.phys()["angle"])
         if None not in q:
-            out.append((t, tuple(q)))
-    return out
+            out[round(t / T.LCP_CONTROL_S)] = (t, tuple(q))     # the set points of one period go out together
+    return list(out.values())
 
 
 @pytest.mark.parametrize("x_mm, y_mm", [(0.0, 120.0), (30.0, 110.0), (-35.0, 95.0)])
@@ -103,8 +104,10 @@ def test_lcp_reports_blocked_leg_and_retries_higher(spec):
     rig = Rig(spec, "LCP", LCP1, blocked)
     rig.inject(0.3, MMC, M.LegTarget.from_phys(phase=int(LegPhase.SWING), x=40, y=120, z=30, duration=1000))
     rig.inject(0.8, MMC, M.LegPoll())
+    rig.run(0.45)
+    assert rig.node.seg.swing and rig.node.seg.lift == pytest.approx(G.step_limit + 0.01)  # retried, to the step limit
     rig.run(1.0)
     (_, f), = rig.frames(M.LegReport)
     assert f.message.flags & LegFlags.BLOCKED and f.message.servo_temp == 35
-    assert rig.node.seg[2] == pytest.approx(G.step_limit + 0.01)  # retried swing lifted to the step limit
+    assert rig.node.failed                                        # stalled through the retry too: drive failed
     assert any(e == "blocked" for _, e, _ in rig.board.notes)

@@ -99,10 +99,131 @@ def test_status_ack_reports_gait_direction_and_a_blocked_leg(spec):
     assert ack.error == MmcError.LEG_DRIVE_BLOCKED and 1 <= ack.leg <= 6     # seed 6.1
 
 
-def test_no_ground_under_a_foot_stops_the_robot(spec):
-    rig = walking_rig(spec, 1.0, flags=int(LegFlags.NO_GROUND))
-    assert rig.node.gait.command == MovCmd.STOP                  # seed 1.2.2: a pit
-    assert any(e == "pit" for _, e, _ in rig.board.notes)
+def status(rig: Rig) -> M.StatusAckMmc:
+    rig.inject(rig.board.t + 0.01, MCP, M.StatusReq())
+    rig.run(rig.board.t + 0.1)
+    return rig.frames(M.StatusAckMmc)[-1][1].message
+
+
+def move(rig: Rig, cmd: MovCmd) -> None:
+    rig.inject(rig.board.t + 0.01, MCP, M.MoveRelayed(address=NP3, mov_cmd=int(cmd), param=0))
+    rig.run(rig.board.t + 0.05)
+
+
+def scripted_legs(flags: dict[int, int], silent: set[int], status: dict[int, int] | None = None):
+    """Legs answering with per-leg LEG_REPORT flags (changeable during the test); `silent` legs never answer."""
+    def respond(f):
+        leg = LEG_OF.get(f.dst)
+        if leg in silent:
+            return []
+        if isinstance(f.message, M.LegPoll):
+            return [(f.dst, M.LegReport(flags=flags.get(leg, int(LegFlags.CONTACT)), x=0, y=0, z=0, servo_temp=20))]
+        if isinstance(f.message, M.StatusReq) and leg is not None and rig_started[0]:
+            return [(f.dst, M.StatusAckOrder(status=(status or {}).get(leg, 0)))]
+        return legs_answer()(f)
+    rig_started = [False]
+    respond.started = rig_started                                 # type: ignore[attr-defined]
+    return respond
+
+
+def started_rig(spec, flags, silent, st=None) -> Rig:
+    respond = scripted_legs(flags, silent, st)
+    rig = Rig(spec, "MMC", MMC, respond)
+    rig.run(0.5)
+    respond.started[0] = True                                     # POST is over: run-time answers from now on
+    move(rig, MovCmd.FORWARD)
+    return rig
+
+
+def test_no_ground_stops_the_robot_once_and_the_next_move_walks_away(spec):
+    flags: dict[int, int] = {}
+    rig = started_rig(spec, flags, set())
+    rig.run(1.5)
+    flags[2] = int(LegFlags.NO_GROUND)                            # leg 2's foot finds a pit
+    rig.run(2.5)
+    assert rig.node.gait.command == MovCmd.STOP                  # seed 1.2.2: stop at once (local safety)
+    ack = status(rig)
+    assert (ack.error, ack.leg, ack.direction) == (MmcError.NO_GROUND, 2, Direction.STOP)
+    move(rig, MovCmd.BACKWARD)                                    # the NP3 backs off: obeyed although the
+    rig.run(rig.board.t + 1.0)                                    # foot still finds no ground
+    assert rig.node.gait.command == MovCmd.BACKWARD and status(rig).error == MmcError.NO_GROUND
+    assert sum(1 for _, e, _ in rig.board.notes if e == "pit") == 1
+    flags[2] = int(LegFlags.CONTACT)                              # the foot has ground again: error clears
+    rig.run(rig.board.t + 1.0)
+    assert status(rig).error == MmcError.NONE
+
+
+def test_a_silent_lcp_is_out_of_order_and_five_legs_walk_on(spec):
+    silent: set[int] = set()
+    rig = started_rig(spec, {}, silent)
+    rig.run(2.0)
+    silent.add(3)                                                 # LCP(3) dies
+    rig.run(2.6)
+    ack = status(rig)
+    assert (ack.error, ack.leg) == (MmcError.LCP_OUT_OF_ORDER, 3) and ack.direction == Direction.FORWARD
+    assert [d for _, e, d in rig.board.notes if e == "five_legged_gait"] == [{"leg": 3}]
+    assert rig.node.gait.legs == (1, 2, 4, 5, 6) and ack.gait == Gait.WAVE
+    t = rig.board.t
+    rig.run(t + 6.0)
+    late = [f.dst for ts, f in rig.frames(M.LegTarget) if ts > t]
+    assert LCP[3] not in late and {LCP[1], LCP[6]} <= set(late)
+    swings = {LEG_OF[f.dst] for ts, f in rig.frames(M.LegTarget) if ts > t + 1 and f.message.phase == LegPhase.SWING}
+    assert swings == {1, 2, 4, 5, 6}                              # all five others step
+    assert rig.node.gait.max_up == 1                              # one foot up, four down
+
+
+def test_a_jac_fault_loses_the_leg_and_holds_it_lifted(spec):
+    flags: dict[int, int] = {}
+    rig = started_rig(spec, flags, set())
+    rig.run(2.0)
+    flags[5] = int(LegFlags.JAC_FAULT)
+    rig.run(3.0)
+    ack = status(rig)
+    assert (ack.error, ack.leg) == (MmcError.JAC_OUT_OF_ORDER, 5)
+    (_, last), *_ = reversed(rig.frames(M.LegTarget, LCP[5]))
+    assert last.message.phase == LegPhase.RETRACT and last.message.phys()["z"] > 0      # out of the way
+
+
+def test_blocked_leg_then_failed_then_clean(spec):
+    flags: dict[int, int] = {}
+    st: dict[int, int] = {}
+    rig = started_rig(spec, flags, set(), st)
+    rig.run(1.5)
+    flags[4] = int(LegFlags.CONTACT | LegFlags.BLOCKED)
+    rig.run(2.5)
+    assert (status(rig).error, status(rig).leg) == (MmcError.LEG_DRIVE_BLOCKED, 4)
+    swing_lifts = [f.message.z for ts, f in rig.frames(M.LegTarget) if ts > 2.0 and f.message.phase == LegPhase.SWING]
+    assert swing_lifts and min(swing_lifts) > round(G.lift * 10000)     # every leg steps high near the obstacle
+    st[4] = 1                                                     # the LCP's retry was blocked too
+    rig.run(3.5)
+    assert status(rig).error == MmcError.LEG_DRIVE_FAILED
+    flags[4] = int(LegFlags.CONTACT)                              # a clean step
+    st[4] = 0
+    rig.run(4.5)
+    assert status(rig).error == MmcError.NONE
+
+
+def test_overtemperature_slows_the_gait(spec):
+    flags: dict[int, int] = {}
+    rig = started_rig(spec, flags, set())
+    rig.run(1.5)
+    assert rig.node.gait.scale == 1.0
+    flags[6] = int(LegFlags.CONTACT | LegFlags.OVERTEMP)
+    rig.run(2.5)
+    assert rig.node.gait.scale < 1.0
+    flags[6] = int(LegFlags.CONTACT)
+    rig.run(3.5)
+    assert rig.node.gait.scale == 1.0
+
+
+def test_gait_change_while_walking_keeps_the_direction(spec):
+    rig = walking_rig(spec, 3.0)
+    move(rig, MovCmd.RIPPLE)
+    ack = status(rig)
+    assert (ack.gait, ack.direction) == (Gait.RIPPLE, Direction.FORWARD)     # seed 3.2.3
+    rig.run(rig.board.t + 4.0)
+    assert rig.node.gait.running == MovCmd.RIPPLE and rig.node.gait.command == MovCmd.FORWARD
+    assert rig.node.debug_metrics()["gait_switches"] == 1
 
 
 def test_post_reports_a_missing_leg_and_walks_on_five_in_wave_gait(spec):

@@ -6,9 +6,8 @@ import math
 import pytest
 
 from arachnae_proto.enums import MovCmd
-from behaviours.subsumption import (
-    AVOIDANCE, NONE_LAYER, REFLEXES, TASK, FunctionModule, Network, np3_network, whiskers_from_tpsc,
-)
+from behaviours.np3_layers import AVOIDANCE, REFLEXES, TASK
+from behaviours.subsumption import NONE_LAYER, FunctionModule, Network, np3_network
 
 
 class FakeClock:
@@ -79,11 +78,12 @@ def test_inhibition_blocks_the_lower_output_without_replacing_it():
 def test_trace_intervals_cover_the_run_and_summary_sums_per_layer():
     clock = FakeClock(2.0)
     net = np3_network(clock, task="forward")
-    net.sense(battery_v=4.8, tilt=(0.0, 0.0), whiskers=(False, False), ir=(None, None, None))
+    net.sense(battery_low=False, tilt=(0.0, 0.0), ir=(None, None, None))
 
     def world(t: float) -> None:
-        net.sense(whiskers=(True, False) if 5.0 <= t < 5.3 else (False, False),
-                  ir=(None, 0.3, None) if 15.0 <= t < 15.3 else (None, None, None))
+        if abs(t - 5.0) < 1e-9:                      # a head-on whisker contact (both sides, seed 3.2.12)
+            net.sense(whisker=(1, True, True, t))
+        net.sense(ir=(None, 0.07, None) if 15.0 <= t < 15.3 else (None, None, None))
 
     run(net, clock, 30.0, each=world)
     trace = net.trace("move")
@@ -95,45 +95,54 @@ def test_trace_intervals_cover_the_run_and_summary_sums_per_layer():
     summary = trace.summary(until=30.0)
     assert sum(summary.values()) == pytest.approx(28.0)
     assert set(summary) == {TASK, REFLEXES, AVOIDANCE}
-    # the contact reflex's manoeuvre is 1.6 + 3.2 s, plus its suppressor's hold of 0.5 s
-    assert summary[REFLEXES] == pytest.approx(1.6 + 3.2 + 0.5 - 0.1, abs=0.11)
+    # the contact reflex's manoeuvre is 1.6 + 2.4 s, plus its suppressor's hold of 0.5 s
+    assert summary[REFLEXES] == pytest.approx(1.6 + 2.4 + 0.5 - 0.1, abs=0.11)
+    assert trace.switches(until=30.0) == 4          # task, reflexes, task, avoidance, task
     assert NONE_LAYER not in summary                # the task drives from the very first step
 
 
 def test_a_reflex_pre_empts_the_task_in_the_same_step():
     clock = FakeClock()
     net = np3_network(clock, task="forward")
-    net.sense(whiskers=(False, False))
     assert net.step()["move"] == MovCmd.FORWARD
     clock.t = 0.1
-    net.sense(whiskers=(True, False))                # seed 3.2.12: OBJ_LEFT
+    net.sense(whisker=(1, True, True, 0.1))          # seed 3.2.12: OBJ_BOTH
     assert net.step()["move"] == MovCmd.BACKWARD     # 5.2: reaction well within 1 s: this very step
     assert net.trace("move").current == (0.1, REFLEXES, "contact")   # (since, layer, module)
-    clock.t = 1.8                                    # after backing off it turns away from the left contact
-    net.sense(whiskers=(False, False))
+    clock.t = 1.8                                    # after backing off it turns away
+    assert net.step()["move"] in (MovCmd.TURN_LEFT, MovCmd.TURN_RIGHT)
+    clock.t = 7.0
+    net.sense(whisker=(2, True, False, 7.0))         # OBJ_LEFT alone: turn right at once, no backing off
     assert net.step()["move"] == MovCmd.TURN_RIGHT
+
+
+def test_a_stale_whisker_event_starts_nothing():
+    clock = FakeClock(3.0)
+    net = np3_network(clock, task="forward")
+    net.sense(whisker=(1, True, True, 1.0))          # delivered 2 s ago, while another reflex held the MMC
+    assert net.step()["move"] == MovCmd.FORWARD
 
 
 def test_stop_reflexes_win_over_backing_off():
     clock = FakeClock()
     net = np3_network(clock, task="forward")
-    net.sense(whiskers=(True, True), battery_v=4.3)  # contact and under-voltage at once (3.2.17: stop)
+    net.sense(whisker=(1, True, True, 0.0), battery_low=True)   # contact and under-voltage at once (3.2.17)
     assert net.step()["move"] == MovCmd.STOP
-    net.sense(battery_v=4.8, whiskers=(False, False))
-    clock.t = 0.3                                    # still within the battery suppressor's hold
+    net.sense(ir_fault=True)
+    clock.t = 0.3
     assert net.step()["move"] == MovCmd.STOP
 
 
 def test_avoidance_turns_away_from_the_nearer_side_and_task_resumes():
     clock = FakeClock()
     net = np3_network(clock, task="forward")
-    net.sense(ir=(0.2, None, None))                  # obstacle on the left, not yet a contact
+    net.sense(ir=(0.05, None, None))                 # obstacle on the left, not yet a contact
     assert net.step()["move"] == MovCmd.TURN_RIGHT
     net.sense(ir=(None, None, None))
     clock.t = 0.1
     log = dict(run(net, clock, 5.0))
     resumed = min(t for t, v in log.items() if v == MovCmd.FORWARD)
-    assert resumed == pytest.approx(1.6 + 0.5, abs=0.11)   # turn plan, then the hold releases
+    assert resumed == pytest.approx(0.8 + 0.3, abs=0.11)   # turn plan, then the hold releases
 
 
 def test_wiring_table_lists_every_declared_connection():
@@ -142,8 +151,8 @@ def test_wiring_table_lists_every_declared_connection():
     lines = table.splitlines()
     assert lines[0].split() == ["kind", "from", "to", "hold", "s"]
     assert any(l.split()[:3] == ["wire", "task.move", "actuator.move"] for l in lines)
-    assert any(l.split() == ["suppress", "avoid.move", "actuator.move", "0.5"] for l in lines)
-    assert sum(1 for l in lines if l.startswith("suppress")) == 1 + 6   # avoidance + six reflexes
+    assert any(l.split() == ["suppress", "avoid.move", "actuator.move", "0.3"] for l in lines)
+    assert sum(1 for l in lines if l.startswith("suppress")) == 2 + 6   # orient, avoidance + six reflexes
     assert len(lines) == 2 + len(net.wires) + len(net.nodes)
 
 
@@ -159,18 +168,20 @@ def test_cycles_and_bad_ports_are_rejected():
         net.step()
 
 
-def test_tpsc_byte_decodes_to_whiskers():
-    assert whiskers_from_tpsc(0x10) == (True, False)
-    assert whiskers_from_tpsc(0x20) == (False, True)
-    assert whiskers_from_tpsc(0x40) == (True, True)
-    assert whiskers_from_tpsc(0x00) == (False, False)
-
-
-def test_explore_turns_periodically():
+def test_explore_without_a_goal_wanders_with_growing_turns():
     clock = FakeClock()
     net = np3_network(clock, task="explore")
     log = run(net, clock, 45.0)
-    turns = [t for t, v in log if v == MovCmd.TURN_LEFT]
-    assert turns and math.isclose(turns[0], 20.0, abs_tol=1e-6)
-    assert any(abs(t - 40.0) < 1e-6 for t in turns)
-    assert len(turns) == 2 * 16                      # 1.6 s each at 10 Hz
+    turns = [t for t, v in log if v in (MovCmd.TURN_LEFT, MovCmd.TURN_RIGHT)]
+    assert turns and math.isclose(turns[0], 12.0, abs_tol=1e-6)     # NP3_EXPLORE_WANDER_S
+    assert dict(log)[12.0] == MovCmd.TURN_LEFT and dict(log)[12.0 + 4.8 + 12.0] == MovCmd.TURN_RIGHT
+
+
+def test_explore_steers_for_the_goal():
+    clock = FakeClock()
+    net = np3_network(clock, task="explore")
+    net.sense(pose=(0.0, 0.0, 0.0), goal=(0.0, 2.0))     # 90 degrees to the left
+    assert net.step()["move"] == MovCmd.TURN_LEFT
+    clock.t = 0.1
+    net.sense(pose=(0.0, 0.0, math.radians(80)))
+    assert net.step()["move"] == MovCmd.FORWARD

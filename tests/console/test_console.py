@@ -1,16 +1,18 @@
-"""UIC/RCP console (seed 4.1): keymap, VT100 screen bytes, and a real pty end to end."""
+"""UIC/RCP console (seed 4.1): keymap, VT100 screen bytes, the host's terminal lines."""
 from __future__ import annotations
 
 import os
 import re
+import select
 import time
 
 import pytest
 
 from arachnae_proto import messages as M
 from arachnae_proto.enums import Alert, MovCmd
-from console import KEYMAP, Screen, attach, message_for_key, open_pty
+from console import KEYMAP, Screen, message_for_key
 from console.screen import CLEAR_LINE, LCD_COL, LCD_TOP_ROW, goto
+from console.terminal import attach, open_pty
 
 
 def test_keymap_sends_the_seed_commands_as_generated_messages():
@@ -56,67 +58,73 @@ def test_alert_rings_the_bell_and_blinks():
 def read_until(fd: int, pattern: bytes, timeout: float = 2.0) -> bytes:
     data, end = b"", time.monotonic() + timeout
     while pattern not in data and time.monotonic() < end:
-        import select
-
         if select.select([fd], [], [], 0.05)[0]:
             data += os.read(fd, 4096)
     return data
 
 
-def test_pty_end_to_end_key_in_move_out_lcd_in_vt100_out():
-    console, master = open_pty()
+def test_pty_line_carries_keys_in_and_vt100_out():
+    port, term = open_pty()
     try:
-        first = read_until(master, b"UIC/RCP")
-        assert b"\x1b[2J" in first                                   # the picture arrived on the terminal
-        os.write(master, b"F")                                       # the operator types F
-        msgs = console.poll(timeout=2.0)
-        assert len(msgs) == 1 and isinstance(msgs[0], M.Move) and msgs[0].mov_cmd == MovCmd.FORWARD
-        assert b"MOVE FORWARD" in read_until(master, b"MOVE FORWARD")   # echoed on the status line
-        os.write(master, b"hp")
-        time.sleep(0.05)
-        msgs = console.poll(timeout=1.0)
-        msgs += console.poll(timeout=0.2)
-        assert [m.NAME for m in msgs] == ["MOVE", "POST_REQ"] and msgs[0].mov_cmd == MovCmd.STOP
-        # an LCD_TEXT from the MCP, decoded from its wire bytes, comes out as VT100
-        lcd = M.LcdText.decode(M.LcdText(line=1, text="Leg blocked").encode())
-        console.handle(lcd)
-        out = read_until(master, b"Leg blocked")
-        assert b"\x1b[5;2H\x1b[7mLeg blocked     \x1b[0m" in out
+        port.write(Screen().full())
+        assert b"UIC/RCP" in read_until(term, b"UIC/RCP")              # the picture reached the terminal
+        os.write(term, b"Fh")                                         # the operator types
+        assert port.read(timeout=2.0) + port.read(timeout=0.1) == b"Fh"
     finally:
-        console.close()
-        os.close(master)
+        port.close()
+        os.close(term)
 
 
 def test_pyserial_port_on_a_pty_device():
     import pty
 
     master, slave = pty.openpty()
-    console = attach(os.ttyname(slave))                             # pyserial opens the device path
+    port = attach("serial:" + os.ttyname(slave))                      # pyserial opens the device path
     try:
-        assert b"UIC/RCP" in read_until(master, b"UIC/RCP")
+        port.write(b"\x1b[4;2HWave gait")
+        assert b"Wave gait" in read_until(master, b"Wave gait")
         os.write(master, b"3")
-        msgs = console.poll(timeout=2.0)
-        assert [(m.NAME, m.mov_cmd) for m in msgs] == [("MOVE", MovCmd.WAVE)]
-        console.show_lcd(0, "Wave gait")
-        assert b"\x1b[4;2H\x1b[7mWave gait" in read_until(master, b"Wave gait")
+        assert port.read(timeout=2.0) == b"3"
     finally:
-        console.close()
+        port.close()
         os.close(master)
         os.close(slave)
 
 
 def test_attach_pty_gives_a_device_a_terminal_program_can_open():
-    console = attach("pty")
+    port = attach("pty")
     try:
-        assert console.peer and console.peer.startswith("/dev/")
-        fd = os.open(console.peer, os.O_RDWR | os.O_NOCTTY)          # what picocom / screen would do
+        assert port.peer and port.peer.startswith("/dev/")
+        fd = os.open(port.peer, os.O_RDWR | os.O_NOCTTY)              # what picocom / screen would do
         try:
+            port.write(b"ARACHNAE II  UIC/RCP")
             assert b"UIC/RCP" in read_until(fd, b"UIC/RCP")
             os.write(fd, b"B")
-            msgs = console.poll(timeout=2.0)
-            assert [m.mov_cmd for m in msgs] == [MovCmd.BACKWARD]
-            assert console.sent == msgs
+            assert port.read(timeout=2.0) == b"B"
         finally:
             os.close(fd)
     finally:
-        console.close()
+        port.close()
+
+
+def test_a_terminal_nobody_reads_does_not_stall_the_writer():
+    port, term = open_pty()
+    try:
+        t0 = time.monotonic()
+        for _ in range(200):                                          # far more than the pty buffers
+            port.write(b"x" * 1024)
+        assert time.monotonic() - t0 < 3 * port.write_timeout + 1.0
+        assert port.stalled
+        assert b"xxxx" in read_until(term, b"xxxx")                   # what fitted is there
+    finally:
+        port.close()
+        os.close(term)
+
+
+def test_the_firmware_side_does_not_pull_in_the_host_terminal():
+    import subprocess
+    import sys
+
+    code = "import sys, behaviours.level0; print('console.terminal' in sys.modules, 'termios' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["False", "False"]

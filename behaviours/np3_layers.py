@@ -1,0 +1,435 @@
+"""The NP3's subsumption network (SPEC-NOTES decision 8, seed 5.1-5.2, 6): its layers, tasks and wiring.
+
+Layers, lowest (strongest) first, as the issue orders them:
+  - reflexes: contact (whisker or IR very close), pit (MMC NO_GROUND), dangerous
+    tilt, low battery, blocked leg, unreliable or failed IR;
+  - avoidance: an obstacle ahead seen by the IR beams or the sonar;
+  - task: the current task (forward, explore, wall_follow, seek_light,
+    avoid_light, idle), with a sound-orienting module on top of it.
+
+Every module reads registers the NP3 node fills from the DATA records it
+receives (behaviours.np3); the wiring is declared data: the task drives the
+actuator "move" (the Mov_Cmd for the MMC, 3.2.3) on an ordinary wire, every
+other module suppresses that input with a time constant. Pure logic: the
+clock is injected and the numbers come from behaviours.tuning.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Callable, Mapping
+
+from arachnae_proto.enums import MovCmd
+
+from behaviours import tuning as T
+from behaviours.subsumption import Clock, Network, Outputs, Plan, ReflexModule
+
+STOP, FORWARD, BACKWARD = MovCmd.STOP, MovCmd.FORWARD, MovCmd.BACKWARD
+LEFT, RIGHT = MovCmd.TURN_LEFT, MovCmd.TURN_RIGHT
+SIDE_LEFT, SIDE_RIGHT = MovCmd.SIDESTEP_LEFT, MovCmd.SIDESTEP_RIGHT
+
+REFLEXES, AVOIDANCE, TASK = "reflexes", "avoidance", "task"
+TASKS = ("forward", "explore", "wall_follow", "seek_light", "avoid_light", "idle")
+
+Steps = list[tuple[float, Any]]
+Trigger = Callable[[Mapping[str, Any], float], "Steps | None"]
+
+# Sensor registers of the network (set by the node with net.sense(...)):
+#   whisker (seq, l, r, time)    a TPSC contact event      ir (left, centre, right) m, None = nothing in range
+#   ir_fault bool                IRRC unreliable / failed   pit int                 count of MMC NO_GROUND reports
+#   tilt (lon, transverse) deg   ISC                        battery_low bool        latched PSC alarm / low value
+#   leg_blocked (seq, side)      blocked report, +1 left    sonar_ahead_m m | None  a fresh sonar echo ahead
+#   light (seq, x, y, log10 lux) LSC sample at the pose     pose (x, y, heading rad) dead reckoning
+#   goal (x, y) | None           explore: frontier target   sound (seq, direction deg) APU/SDF event
+#   echoes ((x, y, seen_deg, arc_m), ...) obstacle points of the last seconds (sonar, IR, whiskers) at the DR
+#                                pose, seen at body angle seen_deg, somewhere within arc_m across the beam
+SENSORS = ("whisker", "ir", "ir_fault", "pit", "tilt", "battery_low", "leg_blocked", "sonar_ahead_m", "light",
+           "pose", "goal", "sound", "echoes")
+
+
+@dataclass(frozen=True)
+class Tuning:
+    """The network's thresholds and time constants (CHOICE; defaults from behaviours.tuning)."""
+
+    reflex_hold_s: float = T.NP3_REFLEX_HOLD_S
+    avoid_hold_s: float = T.NP3_AVOID_HOLD_S
+    contact_back_s: float = T.NP3_CONTACT_BACK_S
+    contact_turn_s: float = T.NP3_CONTACT_TURN_S
+    contact_side_turn_s: float = T.NP3_CONTACT_SIDE_TURN_S
+    ir_contact_m: float = T.NP3_IR_CONTACT_M
+    avoid_centre_m: float = T.NP3_AVOID_CENTRE_M
+    avoid_side_m: float = T.NP3_AVOID_SIDE_M
+    avoid_sonar_m: float = T.NP3_AVOID_SONAR_M
+    avoid_turn_s: float = T.NP3_AVOID_TURN_S
+    pit_back_s: float = T.NP3_PIT_BACK_S
+    pit_turn_s: float = T.NP3_PIT_TURN_S
+    tilt_limit_deg: float = T.NP3_TILT_LIMIT_DEG
+    tilt_back_s: float = T.NP3_TILT_BACK_S
+    tilt_turn_s: float = T.NP3_TILT_TURN_S
+    leg_blocked_hold_s: float = T.NP3_LEG_BLOCKED_HOLD_S
+    leg_blocked_side_s: float = T.NP3_LEG_BLOCKED_SIDE_S
+    avoid_echo_m: float = T.NP3_AVOID_ECHO_M
+    avoid_half_width_m: float = T.NP3_AVOID_HALF_WIDTH_M
+    sound_min_deg: float = T.NP3_SOUND_MIN_DEG
+    wander_s: float = T.NP3_EXPLORE_WANDER_S
+    wander_turn_s: float = T.NP3_EXPLORE_TURN_S
+    goal_reached_m: float = T.NP3_GOAL_REACHED_M
+    heading_tol_deg: float = T.NP3_HEADING_TOL_DEG
+    wall_target_m: float = T.NP3_WALL_TARGET_M
+    wall_deadband_m: float = T.NP3_WALL_DEADBAND_M
+    wall_corner_m: float = T.NP3_WALL_CORNER_M
+    wall_align_deg: float = T.NP3_WALL_ALIGN_DEG
+    wall_lost_s: float = T.NP3_WALL_LOST_S
+    side_speed_m_s: float = T.NP3_DR_SIDE_M_S
+    light_samples: int = T.NP3_LIGHT_SAMPLES
+    light_min_spread_m: float = T.NP3_LIGHT_MIN_SPREAD_M
+    light_probe_s: float = T.NP3_LIGHT_PROBE_S
+    turn_rate_deg_s: float = T.NP3_DR_TURN_DEG_S   # turn on the spot (measured; nominal 20 deg per 0.8 s)
+
+
+def _seen(ir: Any) -> list[float | None]:
+    return list(ir) if ir else [None, None, None]
+
+
+class _Edge:
+    """Remembers the last event number seen: a reflex starts once per new event, not while a flag stays set."""
+
+    def __init__(self) -> None:
+        self.last: Any = None
+
+    def new(self, value: Any) -> bool:
+        if value is None or value == self.last:
+            return False
+        fresh = self.last is not None or value not in (0, None)
+        self.last = value
+        return fresh
+
+
+# --------------------------------------------------------------------------- level 0: reflexes
+def contact_trigger(t: Tuning) -> Trigger:
+    """seed 3.2.12, 3.2.13, 5.2: a whisker touches or an IR echo is almost at the body -> back off, turn away."""
+    edge = _Edge()
+
+    def trigger(i: Mapping[str, Any], now: float) -> Steps | None:
+        w = i.get("whisker")               # (seq, left, right, time): a touch older than one hold is history
+        touched = edge.new(w) and now - w[3] <= t.reflex_hold_s
+        left, right = (w[1], w[2]) if touched else (False, False)
+        ir = _seen(i.get("ir"))
+        close = [d is not None and d < t.ir_contact_m for d in ir]
+        if not (touched or any(close)):
+            return None
+        if touched:
+            obj_left = left and not right
+        else:                                  # the nearer side beam says where the object is
+            obj_left = (ir[0] or math.inf) < (ir[-1] or math.inf)
+        away = RIGHT if obj_left else LEFT     # seed 3.2.12: OBJ_LEFT -> turn right
+        if touched and left != right and not any(close):
+            return [(t.contact_side_turn_s, away)]     # one whisker grazes: turn away, no need to back off
+        return [(t.contact_back_s, BACKWARD), (t.contact_turn_s, away)]
+    return trigger
+
+
+def pit_trigger(t: Tuning) -> Trigger:
+    """seed 1.2.2 (sole switch), MMC NO_GROUND: a foot found no ground -> back off, turn away."""
+    edge = _Edge()
+    return lambda i, now: [(t.pit_back_s, BACKWARD), (t.pit_turn_s, LEFT)] if edge.new(i.get("pit")) else None
+
+
+def tilt_trigger(t: Tuning) -> Trigger:
+    """seed 3.2.14, decision 8: dangerous inclination -> back off downhill, turn round."""
+    def trigger(i: Mapping[str, Any], now: float) -> Steps | None:
+        tilt = i.get("tilt") or (0.0, 0.0)
+        if max(abs(a) for a in tilt) <= t.tilt_limit_deg:
+            return None
+        lon, tr = tilt
+        if abs(tr) > abs(lon):                 # steep across the body: turn the downhill way, then on
+            return [(t.tilt_turn_s / 2, LEFT if tr > 0 else RIGHT)]
+        return [(t.tilt_back_s, BACKWARD if lon > 0 else FORWARD), (t.tilt_turn_s, LEFT)]
+    return trigger
+
+
+def leg_blocked_trigger(t: Tuning) -> Trigger:
+    """seed 6.1: a blocked leg -> hold still while its LCP retracts it and re-plans the swing, then step
+    sideways away from the obstacle on that leg's side (walking on would press the legs against it)."""
+    edge = _Edge()
+
+    def trigger(i: Mapping[str, Any], now: float) -> Steps | None:
+        b = i.get("leg_blocked")
+        if not edge.new(b):
+            return None
+        away = SIDE_RIGHT if b[1] > 0 else SIDE_LEFT
+        return [(t.leg_blocked_hold_s, STOP), (t.leg_blocked_side_s, away)]
+    return trigger
+
+
+def stop_while(register: str) -> Trigger:
+    """Stop for as long as `register` is true (battery: 3.2.17; unreliable / failed IR: 6.2)."""
+    return lambda i, now: [(T.NP3_PERIOD_S, STOP)] if i.get(register) else None
+
+
+# --------------------------------------------------------------------------- level 1: avoidance
+def avoid_trigger(t: Tuning) -> Trigger:
+    """seed 5.1.2: an obstacle ahead (IR centre or side beam, or the sonar looking ahead) -> turn away from it."""
+    def trigger(i: Mapping[str, Any], now: float) -> Steps | None:
+        left, centre, right = _seen(i.get("ir"))
+        sonar = i.get("sonar_ahead_m")
+        pose = i.get("pose")
+        pts = body_frame(i.get("echoes"), pose) if pose is not None else []
+        near = ((centre is not None and centre < t.avoid_centre_m)
+                or any(d is not None and d < t.avoid_side_m for d in (left, right))
+                or (sonar is not None and sonar < t.avoid_sonar_m)
+                or clear_ahead(pts, t.avoid_half_width_m) < t.avoid_echo_m)   # the memory: legs' corridor
+        if not near:
+            return None
+        if left is not None or right is not None:
+            turn = RIGHT if (left or math.inf) < (right or math.inf) else LEFT
+        else:                                  # the side with less in front of it in the memory
+            crowd = [by for bx, by, _s, _a in pts if 0 < bx < 2 * t.avoid_echo_m and abs(by) < 3 * t.avoid_half_width_m]
+            turn = RIGHT if sum(1 if by > 0 else -1 for by in crowd) > 0 else LEFT
+        return [(t.avoid_turn_s, turn)]
+    return trigger
+
+
+# --------------------------------------------------------------------------- level 2: the task
+def heading_error(pose: tuple[float, float, float], bearing: float) -> float:
+    """Signed angle (rad, counter-clockwise positive) from the robot's heading to `bearing`."""
+    return (bearing - pose[2] + math.pi) % (2 * math.pi) - math.pi
+
+
+Point = tuple[float, float, float, float]
+
+
+def body_frame(echoes: Any, pose: tuple[float, float, float]) -> list[Point]:
+    """Echo points (x, y, seen_deg, arc_m) in the robot's present body frame (x forward, y left)."""
+    x, y, th = pose
+    c, s = math.cos(th), math.sin(th)
+    return [((ex - x) * c + (ey - y) * s, -(ex - x) * s + (ey - y) * c, seen, arc) for ex, ey, seen, arc in echoes or ()]
+
+
+def wall_beside(points: list[Point], reach_m: float = 0.8) -> tuple[float | None, float | None]:
+    """(distance of the right-hand wall from the body centre, its angle to the heading in rad) from the echoes
+    seen to the right (65..115 deg); the angle is a line fitted along the wall, None while too short."""
+    side = [(bx, -by) for bx, by, seen, _arc in points if -115 <= seen <= -65 and 0 < -by < reach_m and -1.0 <= bx <= 0.6]
+    near = [d for bx, d in side if abs(bx) <= 0.4]
+    dist = min(near) if near else None
+    if len(side) < 3 or max(b for b, _ in side) - min(b for b, _ in side) < 0.4:
+        return dist, None
+    n = len(side)
+    mb, md = sum(b for b, _ in side) / n, sum(d for _, d in side) / n
+    sbb = sum((b - mb) ** 2 for b, _ in side)
+    slope = sum((b - mb) * (d - md) for b, d in side) / sbb
+    return dist, math.atan(slope)       # > 0: the wall falls away to the right ahead
+
+
+def clear_ahead(points: list[Point], half_width_m: float) -> float:
+    """Distance from the body centre to the nearest echo surely in the corridor the body (and legs) sweep
+    walking on: a sonar echo whose cone also reaches outside it (a side wall seen at a slant) does not count."""
+    return min((bx for bx, by, _seen, arc in points if bx > 0 and abs(by) + arc < half_width_m), default=math.inf)
+
+
+def light_gradient(samples: list[tuple[float, float, float]], min_spread: float) -> tuple[float, float] | None:
+    """Least-squares plane L = a + gx x + gy y through (x, y, L) samples; None while they are too close together.
+
+    The LSC sits on the body's centre and reads the same in every heading, so
+    the direction to the light only shows in how the reading changes with the
+    position (dead reckoning): the plane's slope points up the gradient.
+    """
+    n = len(samples)
+    if n < 3:
+        return None
+    mx = sum(s[0] for s in samples) / n
+    my = sum(s[1] for s in samples) / n
+    ml = sum(s[2] for s in samples) / n
+    sxx = sum((s[0] - mx) ** 2 for s in samples)
+    syy = sum((s[1] - my) ** 2 for s in samples)
+    sxy = sum((s[0] - mx) * (s[1] - my) for s in samples)
+    sxl = sum((s[0] - mx) * (s[2] - ml) for s in samples)
+    syl = sum((s[1] - my) * (s[2] - ml) for s in samples)
+    det = sxx * syy - sxy * sxy
+    # the smaller spread (eigenvalue of the scatter matrix) must reach min_spread^2 per sample
+    tr = sxx + syy
+    small = tr / 2 - math.sqrt(max(0.0, tr * tr / 4 - det))
+    if small < n * (min_spread / 2) ** 2 or det <= 0:
+        return None
+    return (syy * sxl - sxy * syl) / det, (sxx * syl - sxy * sxl) / det
+
+
+class TaskModule:
+    """Level 2: the current task (decision 8: wall following, seeking / avoiding light, exploring)."""
+
+    inputs = ("ir", "whisker", "light", "pose", "goal", "echoes")
+    outputs = ("move",)
+
+    def __init__(self, task: str, t: Tuning) -> None:
+        if task not in TASKS:
+            raise ValueError(f"unknown task {task!r}; one of {TASKS}")
+        self.name, self.layer, self.task, self.t = "task", TASK, task, t
+        self.plan: Plan | None = None
+        self.samples: list[tuple[float, float, float]] = []
+        self.light_seq: Any = None
+        self.gradient: tuple[float, float] | None = None
+        self.wander_at: float | None = None
+        self.wanders = 0
+        self.reached: Any = None
+        self.obstacle_until = -math.inf
+        self.wall_at: float | None = None
+
+    def step(self, inputs: Mapping[str, Any], now: float) -> Outputs:
+        if self.plan is not None:
+            v = self.plan.value(now)
+            if v is not None:
+                return {"move": v}
+            self.plan = None
+        return {"move": getattr(self, f"_{self.task}")(inputs, now)}
+
+    def _run(self, steps: Steps, now: float) -> Any:
+        self.plan = Plan(steps, now)
+        return self.plan.value(now)
+
+    def _steer(self, pose: tuple[float, float, float], bearing: float) -> MovCmd:
+        err = heading_error(pose, bearing)
+        if abs(err) <= math.radians(self.t.heading_tol_deg):
+            return FORWARD
+        return LEFT if err > 0 else RIGHT
+
+    def _idle(self, i: Mapping[str, Any], now: float) -> MovCmd:
+        return STOP
+
+    def _forward(self, i: Mapping[str, Any], now: float) -> MovCmd:
+        return FORWARD
+
+    def _wander(self, now: float) -> MovCmd:
+        """No goal: walk straight, every so often turn to a new heading (alternately left and right, growing)."""
+        if self.wander_at is None:
+            self.wander_at = now + self.t.wander_s
+        if now < self.wander_at:
+            return FORWARD
+        self.wander_at = now + self.t.wander_s
+        self.wanders += 1
+        turn = LEFT if self.wanders % 2 else RIGHT
+        return self._run([(self.t.wander_turn_s * (1 + self.wanders % 3), turn)], now)
+
+    def _explore(self, i: Mapping[str, Any], now: float) -> MovCmd:
+        """seed 3.3.2: head for the frontier of the topological map the node builds; wander while there is none."""
+        goal, pose = i.get("goal"), i.get("pose")
+        if goal is not None and pose is not None and goal != self.reached:
+            if math.hypot(goal[0] - pose[0], goal[1] - pose[1]) < self.t.goal_reached_m:
+                self.reached = goal
+            else:
+                return self._steer(pose, math.atan2(goal[1] - pose[1], goal[0] - pose[0]))
+        return self._wander(now)
+
+    def _wall_follow(self, i: Mapping[str, Any], now: float) -> MovCmd:
+        """Right-hand wall at a band the sonar can hold (decision 8): sidesteps keep the distance, turns the angle.
+
+        The wall's distance and direction come from the sonar echoes seen to the
+        right over the last seconds (sector minima arrive ~8 s apart per angle),
+        carried along by dead reckoning; the target keeps the feet (0.2 m out)
+        off the wall. Sidesteps change the distance without swinging the body's
+        ends round; a wall ahead is a corner: turn left once the side is clear.
+        """
+        t, pose = self.t, i.get("pose")
+        if pose is None:
+            return FORWARD
+        pts = body_frame(i.get("echoes"), pose)
+        dist, angle = wall_beside(pts)
+        ir = _seen(i.get("ir"))
+        front = clear_ahead(pts, t.wall_target_m - t.wall_deadband_m)
+        side_s = lambda d: min(1.6, max(0.4, abs(d) / t.side_speed_m_s))     # noqa: E731
+        if front < t.wall_corner_m or ir[1] is not None:
+            if dist is not None and dist < t.wall_target_m - t.wall_deadband_m:
+                return self._run([(side_s(t.wall_target_m - dist), SIDE_LEFT)], now)
+            return self._run([(45.0 / t.turn_rate_deg_s, LEFT)], now)        # an inside corner: turn with it
+        if dist is None:
+            if self.wall_at is not None and now - self.wall_at > t.wall_lost_s:
+                self.wall_at = now                   # lost it (an outside corner): turn right, walk on to find it
+                return self._run([(45.0 / t.turn_rate_deg_s, RIGHT), (2.0, FORWARD)], now)
+            return FORWARD
+        self.wall_at = now
+        err = dist - t.wall_target_m
+        if abs(err) > t.wall_deadband_m:
+            return self._run([(side_s(err), SIDE_RIGHT if err > 0 else SIDE_LEFT)], now)
+        if angle is not None and abs(math.degrees(angle)) > t.wall_align_deg:
+            turn = RIGHT if angle > 0 else LEFT
+            return self._run([(abs(math.degrees(angle)) / t.turn_rate_deg_s, turn), (1.0, FORWARD)], now)
+        return FORWARD
+
+    def _seek_light(self, i: Mapping[str, Any], now: float) -> MovCmd:
+        return self._light(i, now, sign=1.0)
+
+    def _avoid_light(self, i: Mapping[str, Any], now: float) -> MovCmd:
+        return self._light(i, now, sign=-1.0)
+
+    def _light(self, i: Mapping[str, Any], now: float, sign: float) -> MovCmd:
+        """Up (or down) the light gradient fitted over the last samples; probe in an L while it is unknown."""
+        t = self.t
+        light, pose = i.get("light"), i.get("pose")
+        if light is not None and light[0] != self.light_seq:
+            self.light_seq = light[0]
+            self.samples = (self.samples + [light[1:]])[-t.light_samples:]
+            self.gradient = light_gradient(self.samples, t.light_min_spread_m)
+        ir = _seen(i.get("ir"))
+        if any(d is not None for d in ir):
+            self.obstacle_until = now + t.light_probe_s / 2    # after an obstacle, walk on past it first
+        if self.gradient is None or pose is None or now < self.obstacle_until:
+            if now < self.obstacle_until:
+                return FORWARD
+            return self._run([(t.light_probe_s, FORWARD), (90.0 / t.turn_rate_deg_s, LEFT)], now)
+        gx, gy = self.gradient
+        return self._steer(pose, math.atan2(sign * gy, sign * gx))
+
+
+class OrientModule:
+    """Task level: turn towards a sound event (seed 3.2.7 APU/SDF direction, body frame, ccw from forward)."""
+
+    inputs = ("sound",)
+    outputs = ("move",)
+
+    def __init__(self, t: Tuning) -> None:
+        self.name, self.layer, self.t = "orient", TASK, t
+        self.edge = _Edge()
+        self.plan: Plan | None = None
+
+    def step(self, inputs: Mapping[str, Any], now: float) -> Outputs:
+        sound = inputs.get("sound")
+        if sound is not None and self.edge.new(sound[0]):
+            err = (sound[1] + 180) % 360 - 180          # -180..180, positive: to the left
+            if abs(err) > self.t.sound_min_deg:
+                self.plan = Plan([(abs(err) / self.t.turn_rate_deg_s, LEFT if err > 0 else RIGHT)], now)
+        if self.plan is not None and self.plan.value(now) is None:
+            self.plan = None
+        return {"move": self.plan.value(now) if self.plan else None}
+
+
+# --------------------------------------------------------------------------- the network
+def np3_network(clock: Clock, task: str = "forward", tuning: Tuning | None = None) -> Network:
+    """The NP3's layered network; its actuator "move" is the Mov_Cmd for the MMC (3.2.3). Sensors: SENSORS."""
+    t = tuning or Tuning()
+    net = Network(clock)
+    reflexes = [   # level 0; declared weakest first: a later suppressor sits closer to the MMC and wins
+        ReflexModule("leg_blocked", REFLEXES, ("leg_blocked",), leg_blocked_trigger(t)),   # seed 6.1
+        ReflexModule("contact", REFLEXES, ("whisker", "ir"), contact_trigger(t)),          # seed 3.2.12, 3.2.13, 5.2
+        ReflexModule("pit", REFLEXES, ("pit",), pit_trigger(t)),                           # seed 1.2.2
+        ReflexModule("tilt", REFLEXES, ("tilt",), tilt_trigger(t)),                        # seed 3.2.14
+        ReflexModule("ir_fault", REFLEXES, ("ir_fault",), stop_while("ir_fault")),        # seed 6.2: IR -> stop
+        ReflexModule("battery", REFLEXES, ("battery_low",), stop_while("battery_low")),   # seed 3.2.17: stop
+    ]
+    avoid = ReflexModule("avoid", AVOIDANCE, ("ir", "sonar_ahead_m", "pose", "echoes"), avoid_trigger(t))    # seed 5.1.2
+    task_module = TaskModule(task, t)
+    orient = OrientModule(t)
+    for m in (task_module, orient, avoid, *reflexes):
+        net.add(m)
+    for m in net.modules.values():
+        for p in m.inputs:
+            net.wire(f"sensor.{p}", f"{m.name}.{p}")
+    move = net.actuator("move")
+    net.wire("task.move", move)
+    net.suppress("orient.move", move, t.avoid_hold_s)         # a sound interrupts the task (seed 3.2.7)
+    net.suppress("avoid.move", move, t.avoid_hold_s)          # seed 5.2: collision handling interrupts navigation
+    for r in reflexes:
+        net.suppress(f"{r.name}.move", move, t.reflex_hold_s)
+    return net
+
+
+__all__ = ["Tuning", "TaskModule", "OrientModule", "np3_network", "light_gradient", "heading_error", "SENSORS",
+           "REFLEXES", "AVOIDANCE", "TASK", "TASKS"]

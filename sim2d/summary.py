@@ -1,0 +1,50 @@
+"""A per-scenario table of the key metrics of a batch of runs (what a reviewer reads first).
+
+Why a table of its own: metrics.json holds everything, but comparing twenty
+scenarios x seeds needs one line each: did it pass, how far, how close to a
+wall, how fast the reactions, which layer of the NP3 held control.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any, Iterable
+
+COLUMNS = ("scenario", "seed", "pass", "POST", "walked m", "collisions", "min clear m", "max react s",
+           "control s (reflex/avoid/task)", "notes")
+_NOTES = ("escape", "five_legged_gait", "operator_message", "blocked", "pit", "led_blink", "speech")
+
+
+def _control(m: dict[str, Any]) -> str:
+    c = (m.get("nodes", {}).get("NP3") or {}).get("control") or {}
+    if not c:
+        return "-"
+    return "/".join(f"{c.get(k, 0.0):.0f}" for k in ("reflexes", "avoidance", "task"))
+
+
+def _notes(m: dict[str, Any]) -> str:
+    notes = m.get("notes", {})
+    return " ".join(f"{k}={notes[k]['count']}" for k in _NOTES if k in notes) or "-"
+
+
+def row(m: dict[str, Any]) -> list[str]:
+    exps = m.get("expectations", [])
+    ok = all(e["passed"] for e in exps)
+    r = m.get("max_reaction_s")
+    clear = m.get("min_clearance_m")
+    return [m["scenario"], str(m["seed"]), "PASS" if ok else "FAIL", str(m["post"]["verdict"]),
+            f"{m['distance_walked_m']:.2f}", str(m["collisions"]), "-" if clear is None else f"{clear:.2f}",
+            "-" if r is None else f"{r:.2f}", _control(m), _notes(m)]
+
+
+def markdown(metrics: Iterable[dict[str, Any]]) -> str:
+    rows = [row(m) for m in sorted(metrics, key=lambda m: (m["scenario"], m["seed"]))]
+    lines = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
+    lines += ["| " + " | ".join(r) + " |" for r in rows]
+    return "\n".join(lines) + "\n"
+
+
+def from_folder(root: str | Path) -> str:
+    """The table over every <run>/metrics.json below `root` (the output of `arachnae sim batch`)."""
+    found = sorted(Path(root).glob("*/metrics.json"))
+    return markdown(json.loads(p.read_text()) for p in found)

@@ -1,0 +1,155 @@
+"""LCP (seed 3.2.10, 6.1): swing profile, blocked-leg reflex, no ground, JAC faults and over-temperature."""
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from arachnae_proto import messages as M
+from arachnae_proto.enums import JointFlags, LegFlags, LegPhase, OrderStatus
+
+from behaviours import tuning as T
+from behaviours.geometry import DEFAULT_GEOMETRY as G
+from behaviours.kinematics import fk, swing_point
+from tests.behaviours.rig import Rig
+from tests.behaviours.test_lcp_kinematics import JACS, commanded, jacs_answer
+
+MMC, LCP1 = 0x03, 0x21
+
+
+def answer(current_ma: int = 50, temp: int = 31, flags: int = 0, silent: tuple = ()):
+    def respond(f):
+        if isinstance(f.message, M.JointPoll):
+            if f.dst in silent:
+                return []
+            return [(f.dst, M.JointFeedback(angle=0, speed=0, current=current_ma, temperature=temp, flags=flags))]
+        return jacs_answer(f)
+    return respond
+
+
+def report(rig: Rig, at: float) -> M.LegReport:
+    rig.inject(at, MMC, M.LegPoll())
+    rig.run(at + 0.05)
+    return rig.frames(M.LegReport)[-1][1].message
+
+
+def status(rig: Rig, at: float) -> int:
+    rig.inject(at, MMC, M.StatusReq())
+    rig.run(at + 0.05)
+    return rig.frames(M.StatusAckOrder, MMC)[-1][1].message.status
+
+
+def swing(rig: Rig, at: float, x: float = 40, y: float = 120, z: float = 30, ms: int = 1000) -> None:
+    rig.inject(at, MMC, M.LegTarget.from_phys(phase=int(LegPhase.SWING), x=x, y=y, z=z, duration=ms))
+
+
+def stance(rig: Rig, at: float, x: float = -40, y: float = 120, ms: int = 1000) -> None:
+    rig.inject(at, MMC, M.LegTarget.from_phys(phase=int(LegPhase.STANCE), x=x, y=y, z=0, duration=ms))
+
+
+def test_swing_point_lifts_straight_up_carries_over_and_lowers_straight_down():
+    start, end, lift, edge = (0.0, 0.2, 0.0), (0.08, 0.2), 0.03, 0.25
+    pts = [swing_point(start, end, lift, i / 100, edge) for i in range(101)]
+    for s, (x, y, z) in zip((i / 100 for i in range(101)), pts):
+        if s <= edge:
+            assert (x, y) == (0.0, 0.2)                       # lift-off: vertical
+        elif s < 1 - edge:
+            assert z == pytest.approx(lift)                    # transfer at full height
+        else:
+            assert (x, y) == end                               # touch-down: vertical
+    assert pts[0][2] == 0.0 and pts[-1][2] == pytest.approx(0.0) and pts[50][0] == pytest.approx(0.04)
+    # a swing re-planned in the air needs no second lift-off
+    mid = swing_point((0.02, 0.2, 0.03), end, lift, 0.01, edge)
+    assert mid[2] == pytest.approx(0.03) and mid[0] > 0.02
+
+
+def test_lcp_swing_profile_on_the_wire(spec):
+    rig = Rig(spec, "LCP", LCP1, jacs_answer)
+    rig.run(1.0)
+    swing(rig, 1.0)
+    rig.run(2.5)
+    hx, hy = G.hip(1)
+    feet = [(t, fk(G, 1, *q)) for t, q in commanded(rig) if 1.0 < t < 2.2]
+    start = G.neutral_foot(1)
+    early = [p for t, p in feet if t < 1.0 + T.LCP_SWING_EDGE - 0.1]
+    late = [p for t, p in feet if t > 2.0 - T.LCP_SWING_EDGE + 0.1]
+    assert early and late
+    assert all(p[0] == pytest.approx(start[0], abs=1e-3) for p in early)                  # straight up first
+    assert early[-1][2] > 0.01
+    assert all(p[0] == pytest.approx(hx + 0.04, abs=1e-3) for p in late)                 # straight down last
+    assert max(p[2] for _, p in feet) == pytest.approx(0.03, abs=5e-4)
+
+
+def test_blocked_swing_retracts_retries_high_and_fails_when_blocked_again(spec):
+    current = {"ma": 50}
+
+    def respond(f):
+        return answer(current_ma=current["ma"])(f)
+    rig = Rig(spec, "LCP", LCP1, respond)
+    rig.run(1.0)
+    swing(rig, 1.0)
+    rig.run(1.4)
+    current["ma"] = 1800                                       # seed 6.1: the foot hits something, stall current
+    rig.run(1.5)
+    node = rig.node
+    assert node.seg.swing and node.seg.lift == pytest.approx(G.step_limit + T.LCP_RETRY_CLEARANCE_M)
+    back = node.seg.start
+    assert back[0] < G.hip(1)[0] + 0.04                          # pulled back towards the lift-off point
+    assert report(rig, 1.5).flags & LegFlags.BLOCKED
+    assert status(rig, 1.55) == OrderStatus.IN_ORDER             # blocked once: it re-plans, not failed
+    rig.run(1.9)                                                 # still stalled well into the retry
+    assert node.failed and status(rig, 1.9) == OrderStatus.OUT_OF_ORDER     # leg drive failed
+    current["ma"] = 50
+    stance(rig, 2.1)
+    swing(rig, 3.2, x=30)                                        # the next swing steps high, and cleanly
+    rig.run(3.3)
+    assert node.seg.lift == pytest.approx(G.step_limit + T.LCP_RETRY_CLEARANCE_M)
+    stance(rig, 4.3)
+    rig.run(4.4)
+    assert not report(rig, 4.4).flags & LegFlags.BLOCKED         # a clean step clears the block
+    assert status(rig, 4.5) == OrderStatus.IN_ORDER
+    assert sum(1 for _, e, _ in rig.board.notes if e == "blocked") >= 2
+
+
+def test_no_ground_under_a_stance_foot_hovers_and_clears_on_contact(spec):
+    rig = Rig(spec, "LCP", LCP1, jacs_answer)
+    rig.run(1.0)
+    stance(rig, 1.0, x=0, ms=3000)
+    rig.run(1.0 + T.LCP_SETTLE_S - 0.1)
+    rig.board.sole = False                                       # over a pit: the sole finds nothing
+    rig.run(1.2 + T.LCP_SETTLE_S / 2)
+    assert not report(rig, rig.board.t).flags & LegFlags.NO_GROUND     # not yet: contact lost just now
+    rig.run(1.3 + T.LCP_SETTLE_S + 0.1)
+    r = report(rig, rig.board.t)
+    assert r.flags & LegFlags.NO_GROUND and not r.flags & LegFlags.CONTACT
+    rig.run(rig.board.t + 0.3)
+    _, q = commanded(rig)[-1]
+    assert fk(G, 1, *q)[2] == pytest.approx(T.LCP_NO_GROUND_Z_M, abs=5e-4)   # no weight on it: it hovers
+    assert any(e == "no_ground" for _, e, _ in rig.board.notes)
+    rig.board.sole = True
+    rig.run(rig.board.t + 0.2)
+    assert not report(rig, rig.board.t).flags & LegFlags.NO_GROUND
+
+
+def test_a_silent_jac_is_a_jac_fault(spec):
+    rig = Rig(spec, "LCP", LCP1, jacs_answer)
+    rig.run(1.0)
+    rig.respond = answer(silent=(JACS[1],))
+    rig.run(3.0)
+    assert report(rig, 3.0).flags & LegFlags.JAC_FAULT
+    assert status(rig, 3.1) == OrderStatus.OUT_OF_ORDER
+    assert [d for _, e, d in rig.board.notes if e == "jac_fault"] == [{"leg": 1, "jac": JACS[1]}]
+    n = len(rig.frames(M.JointTarget, JACS[1]))
+    rig.run(4.0)
+    assert len(rig.frames(M.JointTarget, JACS[1])) == n          # no more set points to it
+
+
+def test_servo_overtemperature_is_reported_with_the_temperature(spec):
+    rig = Rig(spec, "LCP", LCP1, answer(temp=75, flags=int(JointFlags.OVERTEMP)))
+    rig.run(1.0)
+    r = report(rig, 1.0)
+    assert r.flags & LegFlags.OVERTEMP and r.servo_temp == 75
+    assert sum(1 for _, e, _ in rig.board.notes if e == "servo_overtemp") == 1   # once, not per poll
+    rig.respond = answer(temp=60)
+    rig.run(2.0)
+    assert not report(rig, 2.0).flags & LegFlags.OVERTEMP

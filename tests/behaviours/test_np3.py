@@ -1,0 +1,168 @@
+"""NP3 node (seed 3.2.3, 5.2, 6, decision 8): DATA records in, MOVE records out, through its subsumption network."""
+from __future__ import annotations
+
+import math
+
+import pytest
+from PIL import Image
+
+from arachnae_proto import messages as M
+from arachnae_proto.enums import MmcError, MovCmd, RangeStatus, RecordKind, TpscContact
+from arachnae_proto.network import ADDRESS_OF
+from behaviours.np3 import DeadReckoning, decode
+from behaviours.np3_layers import light_gradient
+from behaviours.units import quantizer
+from tests.behaviours.rig import Rig
+
+MCP, NP3 = ADDRESS_OF["MCP"], ADDRESS_OF["NP3"]
+VALUE, ALARM, STATUS = int(RecordKind.VALUE), int(RecordKind.ALARM), int(RecordKind.STATUS)
+
+
+def grant(frame):
+    """The MCP grants every XMIT_REQ at once (seed 3.2.2 message scheduling)."""
+    return [(MCP, M.XmitGrant())] if isinstance(frame.message, M.XmitReq) else []
+
+
+def np3(spec, task: str = "forward") -> Rig:
+    rig = Rig(spec, "NP3", NP3, grant, task=task)
+    rig.inject(0.05, MCP, M.Init())
+    return rig
+
+
+def data(role: str, value: int, kind: int = VALUE, channel: int = 0) -> M.Data:
+    return M.Data(address=ADDRESS_OF[role], kind=kind, channel=channel, value=value)
+
+
+def moves(rig: Rig) -> list[tuple[float, MovCmd]]:
+    return [(t, MovCmd(f.message.mov_cmd)) for t, f in rig.frames(M.Move, MCP)]
+
+
+def command_at(rig: Rig, t: float) -> MovCmd:
+    return [m for at, m in moves(rig) if at <= t][-1]
+
+
+def test_init_starts_the_task_and_a_whisker_contact_backs_off_within_the_reaction_time(spec):
+    rig = np3(spec)
+    rig.run(1.0)
+    assert moves(rig) == [(pytest.approx(0.05, abs=0.05), MovCmd.FORWARD)]
+    rig.inject(2.0, MCP, data("TPSC", int(TpscContact.OBJ_BOTH)))          # head-on contact
+    rig.run(7.0)
+    after = [(t, m) for t, m in moves(rig) if t >= 2.0]
+    assert after[0][1] == MovCmd.BACKWARD and after[0][0] - 2.0 < 0.1     # seed 5.2: well within 1 s
+    assert any(m in (MovCmd.TURN_LEFT, MovCmd.TURN_RIGHT) for _t, m in after[1:])
+    assert command_at(rig, 7.0) == MovCmd.FORWARD         # back to the task after 1.6 + 2.4 s and the 0.5 s hold
+    metrics = rig.node.debug_metrics()
+    assert set(metrics["control"]) == {"task", "reflexes"}
+    assert sum(metrics["control"].values()) == pytest.approx(7.0 - 0.05, abs=0.15)
+    assert metrics["control"]["reflexes"] == pytest.approx(1.6 + 2.4 + 0.5, abs=0.15)
+    assert metrics["switches"] == 2 and metrics["takeovers"]["contact"] == 1
+
+
+def test_left_whisker_turns_right_without_backing_off(spec):
+    rig = np3(spec)
+    rig.inject(1.0, MCP, data("TPSC", int(TpscContact.OBJ_LEFT)))
+    rig.run(2.0)
+    assert [m for t, m in moves(rig) if t >= 1.0][0] == MovCmd.TURN_RIGHT   # seed 3.2.12: OBJ_LEFT -> right
+
+
+def test_unreliable_ir_stops_the_robot_and_a_contact_cannot_restart_it(spec):
+    rig = np3(spec)
+    rig.inject(1.0, MCP, data("IRRC", int(RangeStatus.UNRELIABLE), STATUS))
+    rig.inject(3.0, MCP, data("TPSC", int(TpscContact.OBJ_LEFT)))
+    rig.run(8.0)
+    assert command_at(rig, 1.2) == MovCmd.STOP                               # seed 6.2
+    assert all(m == MovCmd.STOP for t, m in moves(rig) if t >= 1.0)
+    rig.inject(8.5, MCP, data("IRRC", int(RangeStatus.IN_ORDER), STATUS))
+    rig.run(10.0)
+    assert command_at(rig, 10.0) == MovCmd.FORWARD
+
+
+def test_battery_alarm_stops_for_good(spec):
+    rig = np3(spec)
+    volts = quantizer(M.XmitDataPsc, "voltage")
+    rig.inject(1.0, MCP, data("PSC", volts.raw(4.6), VALUE))
+    rig.run(2.0)
+    assert command_at(rig, 2.0) == MovCmd.FORWARD
+    rig.inject(2.5, MCP, data("PSC", volts.raw(4.25), ALARM))                # seed 3.2.17: under-voltage
+    rig.inject(4.0, MCP, data("PSC", volts.raw(4.6), VALUE))
+    rig.run(30.0)
+    assert command_at(rig, 2.6) == MovCmd.STOP and command_at(rig, 30.0) == MovCmd.STOP
+    assert rig.node.debug_metrics()["battery_low"] is True
+
+
+def test_pit_backs_off_once_per_report_and_blocked_leg_holds_still(spec):
+    rig = np3(spec)
+    rig.inject(1.0, MCP, data("MMC", int(MmcError.NO_GROUND), STATUS, channel=1))
+    rig.run(1.5)
+    assert command_at(rig, 1.5) == MovCmd.BACKWARD
+    rig.run(12.0)
+    assert command_at(rig, 12.0) == MovCmd.FORWARD                           # the report stays; no second escape
+    assert sum(1 for t, m in moves(rig) if m == MovCmd.BACKWARD) == 1
+    rig.inject(12.5, MCP, data("MMC", int(MmcError.LEG_DRIVE_BLOCKED), STATUS, channel=4))
+    rig.run(12.8)
+    assert command_at(rig, 12.8) == MovCmd.STOP                              # seed 6.1: let the LCP re-plan
+
+
+def test_tilt_values_are_twos_complement_and_a_steep_slope_is_refused(spec):
+    deg = quantizer(M.XmitDataIsc, "longitudinal")
+    assert decode("ISC", (-30) & 0xFF) == pytest.approx(-30.0)
+    rig = np3(spec)
+    rig.inject(1.0, MCP, data("ISC", deg.raw(12), VALUE, channel=0))         # a gentle slope: walk on
+    rig.run(2.0)
+    assert command_at(rig, 2.0) == MovCmd.FORWARD
+    rig.inject(2.5, MCP, data("ISC", deg.raw(36), ALARM, channel=0))         # nose up, too steep: back down
+    rig.run(3.0)
+    assert command_at(rig, 3.0) == MovCmd.BACKWARD
+
+
+def test_sonar_ahead_makes_it_avoid_unless_the_usrc_is_declared_unreliable(spec):
+    metres = quantizer(M.XmitDataUsrc, "distance")
+    rig = np3(spec)
+    rig.inject(1.0, MCP, data("USRC", metres.raw(0.25), VALUE, channel=2))   # head 2 deg off the axis
+    rig.run(1.5)
+    assert command_at(rig, 1.5) in (MovCmd.TURN_LEFT, MovCmd.TURN_RIGHT)
+    rig2 = np3(spec)
+    rig2.inject(0.5, MCP, data("USRC", int(RangeStatus.UNRELIABLE), STATUS))  # seed 6.2: ignore its data
+    rig2.inject(1.0, MCP, data("USRC", metres.raw(0.25), VALUE, channel=2))
+    rig2.run(3.0)
+    assert [m for _t, m in moves(rig2)] == [MovCmd.FORWARD]
+
+
+def test_a_sound_to_the_left_turns_the_robot_towards_it(spec):
+    rig = np3(spec, task="idle")
+    rig.inject(1.0, MCP, data("APU/SDF", 70, VALUE, channel=90))             # 90 deg to the left
+    rig.run(10.0)
+    turn = [t for t, m in moves(rig) if m == MovCmd.TURN_LEFT]
+    stop = [t for t, m in moves(rig) if m == MovCmd.STOP and t > 1.0]
+    assert turn and stop
+    assert stop[0] - turn[0] == pytest.approx(90 / 25.0 + 0.3, abs=0.3)      # turn time + suppressor hold
+
+
+def test_artifacts_hold_the_control_trace_and_the_map(spec, tmp_path):
+    metres = quantizer(M.XmitDataUsrc, "distance")
+    rig = np3(spec, task="explore")
+    for k in range(0, 360, 5):                                               # a sweep: walls 1.5 m around
+        rig.inject(1.0 + k / 100, MCP, data("USRC", metres.raw(1.5), VALUE, channel=k))
+    rig.run(12.0)
+    rig.node.write_artifacts(tmp_path)
+    rows = (tmp_path / "control.tsv").read_text().splitlines()
+    assert rows[0] == "start_s\tend_s\tlayer\tmodule" and len(rows) >= 2
+    assert float(rows[-1].split("\t")[1]) == pytest.approx(12.0, abs=0.01)
+    img = Image.open(tmp_path / "topomap.png")
+    assert img.size[0] > 100
+    assert rig.node.debug_metrics()["map"]["seen_m2"] > 3.0                  # the sweep crossed the room
+
+
+def test_dead_reckoning_and_light_gradient():
+    odo = DeadReckoning(0.1, math.radians(25))
+    odo.command(0.0, int(MovCmd.FORWARD))
+    odo.command(10.0, int(MovCmd.TURN_LEFT))
+    odo.command(13.6, int(MovCmd.FORWARD))
+    odo.advance(23.6)
+    x, y, th = odo.pose
+    assert (x, y, math.degrees(th)) == pytest.approx((1.0, 1.0, 90.0), abs=1e-6)
+    # brighter towards +y: the fitted slope points there; samples on a line give no gradient
+    samples = [(x, y, 1.0 + 0.5 * y) for x, y in ((0, 0), (1, 0), (1, 1), (0, 1))]
+    gx, gy = light_gradient(samples, 0.25)
+    assert gx == pytest.approx(0.0, abs=1e-9) and gy == pytest.approx(0.5)
+    assert light_gradient([(0, 0, 1.0), (1, 0, 1.1), (2, 0, 1.2)], 0.25) is None

@@ -1,0 +1,191 @@
+"""Sensor controllers (seed 3.2.11-3.2.17): the three-plus-three rule, SET_ALARM limits, free run."""
+from __future__ import annotations
+
+from arachnae_proto import messages as M
+from arachnae_proto.enums import RangeStatus
+from arachnae_proto.network import ADDRESS_OF as A
+
+from behaviours import tuning as T
+from behaviours.units import quantizer
+from tests.behaviours.rig import Rig
+
+SPU = A["SPU"]
+IR = quantizer(M.XmitDataIrrc, "center")
+US = quantizer(M.XmitDataUsrc, "distance")
+PSC_V = quantizer(M.XmitDataPsc, "voltage")
+
+
+def feed(values):
+    """A hardware reading function returning the given readings in turn, then the last one for ever."""
+    values = list(values)
+
+    def read():
+        return values.pop(0) if len(values) > 1 else values[0]
+    return read
+
+
+def irrc(spec, readings) -> Rig:
+    rig = Rig(spec, "IRRC", A["IRRC"])
+    rig.board.ir_ranges = feed(readings)
+    return rig
+
+
+def beams(cm: float, centre: float | None = None):
+    c = cm if centre is None else centre
+    return (cm / 100, c / 100, cm / 100)
+
+
+def test_irrc_takes_three_more_readings_when_three_spread_and_keeps_its_trust(spec):
+    spread, steady = [beams(5), beams(8), beams(5)], [beams(7)] * 3
+    rig = irrc(spec, spread + steady)
+    rig.run(0.01)                                         # the first measurement, at power-on
+    node = rig.node
+    assert (node.status, node.second_sets) == (RangeStatus.IN_ORDER, 1)
+    assert node.latest == (IR.raw(7),) * 3                # the mean of the second set (3.2.13)
+    assert rig.frames(M.DataRdy) == []
+
+
+def test_irrc_declares_itself_unreliable_when_the_second_three_spread_too(spec):
+    good = [beams(7)] * 3
+    bad = [beams(5), beams(9), beams(5)] * 2
+    rig = irrc(spec, good + bad + [beams(9.5)])
+    rig.run(T.IRRC_MEASURE_S + 0.01)
+    assert rig.node.status == RangeStatus.UNRELIABLE      # seed 3.2.13: declares itself unreliable
+    (_, f), = rig.frames(M.DataRdy)                       # CHOICE: a status change is announced to the SPU
+    assert f.dst == SPU
+    rig.inject(0.2, SPU, M.StatusReq())
+    rig.inject(0.3, SPU, M.XmitData())
+    rig.run(0.4)
+    assert rig.frames(M.StatusAckRange)[-1][1].message.status == RangeStatus.UNRELIABLE
+    # later readings are steady again, but it stays unreliable (CHOICE: until INIT) ...
+    assert rig.node.status == RangeStatus.UNRELIABLE
+    rig.inject(0.5, SPU, M.Init())
+    rig.run(0.6)
+    assert rig.node.status == RangeStatus.IN_ORDER       # ... initialised again, it trusts itself again
+
+
+def test_an_unreliable_measurement_never_replaces_the_last_reliable_value(spec):
+    rig = irrc(spec, [beams(7)] * 3 + [beams(2), beams(9), beams(2)] * 2 + [beams(2)])
+    rig.run(T.IRRC_MEASURE_S + 0.001)                    # the second measurement spread twice
+    rig.inject(rig.board.t, SPU, M.XmitData())            # fetched before the third measurement
+    rig.run(T.IRRC_MEASURE_S * 1.9)
+    (_, f), = rig.frames(M.XmitDataIrrc)
+    assert (f.message.left, f.message.center, f.message.right) == (IR.raw(7),) * 3
+
+
+def test_irrc_alarm_fires_once_on_crossing_and_rearms_with_hysteresis(spec):
+    rig = Rig(spec, "IRRC", A["IRRC"])
+    distance = {"cm": 9.0}
+    rig.board.ir_ranges = lambda: beams(9.0, distance["cm"])
+    rig.inject(0.0, SPU, M.SetAlarmIrrc.from_phys(limit=6.0))
+    rig.run(0.5)
+    assert rig.frames(M.DataRdy) == []
+    distance["cm"] = 5.0                                  # closer than the limit (seed 3.2.13: "Unterschreiten")
+    rig.run(1.0)
+    assert len(rig.frames(M.DataRdy)) == 1               # once, not at every measurement
+    rig.inject(1.0, SPU, M.XmitData())
+    distance["cm"] = 6.5                                  # back, but within the hysteresis
+    rig.run(1.5)
+    distance["cm"] = 5.0
+    rig.run(2.0)
+    assert len(rig.frames(M.DataRdy)) == 1
+    distance["cm"] = 9.0                                  # well clear: re-armed
+    rig.run(2.5)
+    distance["cm"] = 4.0
+    rig.run(3.0)
+    assert len(rig.frames(M.DataRdy)) == 2
+
+
+def test_psc_sends_the_mean_of_its_last_three_and_alarms_below_the_limit(spec):
+    rig = Rig(spec, "PSC", A["PSC"])
+    volts = {"v": 4.8}
+    rig.board.battery = lambda: volts["v"]
+    rig.inject(0.0, SPU, M.SetAlarmPsc.from_phys(limit=4.4))
+    rig.run(2.0)
+    assert rig.frames(M.DataRdy) == []
+    volts["v"] = 4.3
+    rig.run(2.0 + T.PSC_MEASURE_S + 0.01)                 # one low reading: mean (4.8 + 4.8 + 4.3) / 3 > 4.4
+    assert rig.frames(M.DataRdy) == []
+    rig.inject(rig.board.t, SPU, M.XmitData())
+    rig.run(rig.board.t + 0.1)
+    (_, f), = rig.frames(M.XmitDataPsc)
+    assert f.message.voltage == round((2 * PSC_V.raw(4.8) + PSC_V.raw(4.3)) / 3)   # seed 3.2.17
+    rig.run(4.0)
+    (_, f), = rig.frames(M.DataRdy)                       # seed 3.2.17: under-voltage reported on its own
+    assert f.dst == SPU
+
+
+def test_isc_alarms_per_axis_beyond_the_limit_either_way(spec):
+    rig = Rig(spec, "ISC", A["ISC"])
+    tilt = {"deg": (3.0, 0.0)}
+    rig.board.inclination = lambda: tilt["deg"]
+    rig.inject(0.0, SPU, M.SetAlarmIsc.from_phys(channel=1, limit=15))
+    rig.run(1.0)
+    tilt["deg"] = (30.0, 0.0)                             # the longitudinal axis has no alarm set
+    rig.run(2.0)
+    assert rig.frames(M.DataRdy) == []
+    tilt["deg"] = (0.0, -18.0)                            # transverse, downhill side: beyond 15 either way
+    rig.run(3.0)
+    assert len(rig.frames(M.DataRdy)) == 1
+    assert rig.node.alarm_count == 1
+
+
+def test_tsc_alarm_sends_the_hot_probe_first(spec):
+    rig = Rig(spec, "TSC", A["TSC"])
+    temps = {"c": [20.0] * 8}
+    rig.board.temperatures = lambda: tuple(temps["c"])
+    for ch in range(8):
+        rig.inject(0.0, SPU, M.SetAlarmTsc.from_phys(channel=ch, limit=50))
+    rig.run(1.5)
+    temps["c"] = [20.0] * 5 + [60.0] + [20.0] * 2
+    rig.run(2.5)
+    assert len(rig.frames(M.DataRdy)) == 1
+    rig.inject(2.5, SPU, M.XmitData())
+    rig.run(2.6)
+    (_, f), = rig.frames(M.XmitDataTsc)
+    assert (f.message.channel, f.message.temperature) == (5, 60)
+
+
+def test_lsc_alarm_above_a_brightness(spec):
+    rig = Rig(spec, "LSC", A["LSC"])
+    lux = {"lx": 50.0}
+    rig.board.light = lambda: lux["lx"]
+    rig.inject(0.0, SPU, M.SetAlarmLsc.from_phys(limit=500))
+    rig.run(1.0)
+    assert rig.frames(M.DataRdy) == []
+    lux["lx"] = 2000.0
+    rig.run(2.0)
+    assert len(rig.frames(M.DataRdy)) == 1
+
+
+def test_usrc_free_run_announces_the_nearest_echo_of_each_sector(spec):
+    rig = Rig(spec, "USRC", A["USRC"])
+    head_to_m = {h: 3.0 for h in range(360)}
+    head_to_m[4] = 1.0                                    # something near at 4 degrees
+
+    def ping(head):
+        return head_to_m[head], 0.001
+    rig.board.sonar_ping = ping
+    rig.inject(0.0, SPU, M.FreeRun())
+    sector_s = T.USRC_SECTOR_DEG * (3 * 0.001 + T.USRC_HEAD_STEP_S)
+    rig.run(1.2 * sector_s)
+    assert len(rig.frames(M.DataRdy)) == 1                # FREE_RUN: data announced with DATA_RDY
+    rig.inject(rig.board.t, SPU, M.XmitData())
+    rig.run(rig.board.t + 0.05)
+    (_, f), = rig.frames(M.XmitDataUsrc)
+    assert (f.message.distance, f.message.angle) == (US.raw(1.0), 4)      # the sector's minimum
+    rig.run(rig.board.t + 3 * sector_s)
+    assert len(rig.frames(M.DataRdy)) == 4                # one per sector, not one per degree
+
+
+def test_usrc_that_does_not_trust_itself_stops_announcing(spec):
+    rig = Rig(spec, "USRC", A["USRC"])
+    spread = iter([1.0, 3.0, 1.0, 2.0, 4.0, 1.0])        # the first measurement: both sets spread
+
+    def ping(head):
+        return next(spread, 3.0), 0.001
+    rig.board.sonar_ping = ping
+    rig.inject(0.0, SPU, M.FreeRun())
+    rig.run(1.0)
+    assert rig.node.status == RangeStatus.UNRELIABLE
+    assert rig.frames(M.DataRdy) == []                    # seed 6.2: its data is not to be trusted
