@@ -9,9 +9,11 @@ actuator "move" leaves as a MOVE record through the MCP's message
 scheduling (3.2.2): XMIT_REQ, then MOVE when the MCP grants the bus.
 
 Beside the network the node keeps a dead-reckoned pose (CHOICE: from its own
-MOVE commands and the gait's nominal speeds) and the topological map of
+MOVE commands and the gait's measured speeds) and the topological map of
 seed 3.3.2, built from the USRC's echoes (channel = head angle); exploring
-heads for the map's frontier. debug_metrics() reports which layer held the
+heads along the map's least-passed open ray. A short local memory of echoes
+(sonar, IR, whiskers) at the DR pose lets wall following and avoidance see
+what the sensors saw seconds ago. debug_metrics() reports which layer held the
 MMC for how long; write_artifacts() writes control.tsv and topomap.png.
 """
 from __future__ import annotations
@@ -29,7 +31,7 @@ from arachnae_proto.skeletons.np3 import Np3Skeleton
 from behaviours import tuning as T
 from behaviours.np3_layers import AVOIDANCE, REFLEXES, np3_network
 from behaviours.runtime import Runtime
-from behaviours.topomap import OCCUPIED, OccupancyGrid, Reading, TopoMap
+from behaviours.topomap import OCCUPIED, OccupancyGrid, Reading, TopoMap, ray_cells
 from behaviours.units import Quantizer, quantizer
 
 _VALUE, _ALARM, _STATUS = int(RecordKind.VALUE), int(RecordKind.ALARM), int(RecordKind.STATUS)
@@ -177,13 +179,10 @@ class NP3(Runtime, Np3Skeleton):
             turn = (2 * math.pi * k / T.NP3_EXPLORE_HEADINGS + math.pi) % (2 * math.pi) - math.pi
             h = th + turn
             free = fresh = 0.0
-            r = 0.0
-            while r < T.NP3_EXPLORE_REACH_M:
-                r += g.res
-                cell = g.cell(x + r * math.cos(h), y + r * math.sin(h))
+            for cell in ray_cells(x, y, h, T.NP3_EXPLORE_REACH_M, g.res, g.x0, g.y0):
                 if not g.inside(*cell) or g.state(*cell) == OCCUPIED:
                     break
-                free = r
+                free = math.dist((x, y), g.centre(*cell))
                 fresh += g.res * (cell not in self.visited)
             score = fresh + 0.2 * free - 0.3 * abs(turn)
             if free > T.NP3_EXPLORE_MARGIN_M and (best is None or score > best[0]):

@@ -151,4 +151,10 @@ def cmd_batch(args: argparse.Namespace) -> int:
               f"{m['collisions']:>4} {m['frame_loss']:>5} {'FAIL' if bad else 'PASS':6} {m['trace_hash'][:12]}"
               + (f"  failed: {', '.join(bad)}" if bad else ""))
     print(f"{len(rows) - failures} passed, {failures} failed")
+    from sim2d.summary import markdown
+    summary = Path(args.out) / "summary.md"
+    done = [dict(m, expectations=[{"name": n, "passed": ok, "detail": d} for n, ok, d in exps])
+            for _p, _s, m, exps, err in rows if err is None]
+    summary.write_text(markdown(done))
+    print(f"key metrics per run: {summary}")
     return 1 if failures else 0

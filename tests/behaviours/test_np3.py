@@ -9,8 +9,9 @@ from PIL import Image
 from arachnae_proto import messages as M
 from arachnae_proto.enums import MmcError, MovCmd, RangeStatus, RecordKind, TpscContact
 from arachnae_proto.network import ADDRESS_OF
+from behaviours import tuning as T
 from behaviours.np3 import DeadReckoning, decode
-from behaviours.np3_layers import light_gradient
+from behaviours.np3_layers import body_frame, clear_ahead, light_gradient, np3_network, wall_beside
 from behaviours.units import quantizer
 from tests.behaviours.rig import Rig
 
@@ -73,8 +74,9 @@ def test_unreliable_ir_stops_the_robot_and_a_contact_cannot_restart_it(spec):
     assert command_at(rig, 1.2) == MovCmd.STOP                               # seed 6.2
     assert all(m == MovCmd.STOP for t, m in moves(rig) if t >= 1.0)
     rig.inject(8.5, MCP, data("IRRC", int(RangeStatus.IN_ORDER), STATUS))
-    rig.run(10.0)
-    assert command_at(rig, 10.0) == MovCmd.FORWARD
+    rig.run(15.0)
+    assert command_at(rig, 10.0) != MovCmd.STOP                              # moving again; first away from
+    assert command_at(rig, 15.0) == MovCmd.FORWARD                           # the touch it still remembers
 
 
 def test_battery_alarm_stops_for_good(spec):
@@ -135,7 +137,7 @@ def test_a_sound_to_the_left_turns_the_robot_towards_it(spec):
     turn = [t for t, m in moves(rig) if m == MovCmd.TURN_LEFT]
     stop = [t for t, m in moves(rig) if m == MovCmd.STOP and t > 1.0]
     assert turn and stop
-    assert stop[0] - turn[0] == pytest.approx(90 / 25.0 + 0.3, abs=0.3)      # turn time + suppressor hold
+    assert stop[0] - turn[0] == pytest.approx(90 / T.NP3_DR_TURN_DEG_S + 0.3, abs=0.3)   # turn + suppressor hold
 
 
 def test_artifacts_hold_the_control_trace_and_the_map(spec, tmp_path):
@@ -166,3 +168,65 @@ def test_dead_reckoning_and_light_gradient():
     gx, gy = light_gradient(samples, 0.25)
     assert gx == pytest.approx(0.0, abs=1e-9) and gy == pytest.approx(0.5)
     assert light_gradient([(0, 0, 1.0), (1, 0, 1.1), (2, 0, 1.2)], 0.25) is None
+
+
+def test_dead_reckoning_counts_sidesteps():
+    odo = DeadReckoning(0.1, math.radians(25), 0.08)
+    odo.command(0.0, int(MovCmd.TURN_LEFT))
+    odo.command(3.6, int(MovCmd.SIDESTEP_RIGHT))          # facing +y: a sidestep right goes to +x
+    odo.command(13.6, int(MovCmd.STOP))
+    odo.advance(20.0)
+    assert odo.pose == pytest.approx((0.8, 0.0, math.radians(90)), abs=1e-6)
+
+
+def test_a_blocked_right_leg_holds_then_steps_left_away_from_it(spec):
+    rig = np3(spec)
+    rig.inject(1.0, MCP, data("MMC", int(MmcError.LEG_DRIVE_BLOCKED), STATUS, channel=5))   # legs 4..6: right
+    rig.run(4.0)
+    after = [m for t, m in moves(rig) if t >= 1.0]
+    assert after[:2] == [MovCmd.STOP, MovCmd.SIDESTEP_LEFT]                 # seed 6.1, then away from it
+    assert command_at(rig, 4.0) == MovCmd.FORWARD
+
+
+def _wall(y: float, x0: float = -1.0, x1: float = 0.6, seen: float = -90.0, arc: float = 0.04):
+    """Echo points of a straight wall along x at height y (body frame = world frame at pose 0)."""
+    return tuple((x0 + k * 0.1, y, seen, arc) for k in range(int(round((x1 - x0) / 0.1)) + 1))
+
+
+def test_wall_beside_and_the_corridor_ahead_from_remembered_echoes():
+    pose = (0.0, 0.0, 0.0)
+    dist, angle = wall_beside(body_frame(_wall(-0.3), pose))
+    assert dist == pytest.approx(0.3) and angle == pytest.approx(0.0, abs=1e-9)
+    slanted = tuple((x, -0.3 + 0.1 * x, s, a) for x, _y, s, a in _wall(-0.3))   # nearer ahead: turn left
+    assert wall_beside(body_frame(slanted, pose))[1] == pytest.approx(-math.atan(0.1))
+    # a slanted sonar echo 1.1 m ahead may come from the side wall (wide arc): not an obstacle ahead ...
+    assert clear_ahead(body_frame(((1.1, -0.19, -10.0, 0.15),), pose), 0.25) == math.inf
+    # ... a narrow one (IR, or the sonar looking straight at a wall) is
+    assert clear_ahead(body_frame(((0.4, 0.05, 0.0, 0.05),), pose), 0.25) == pytest.approx(0.4)
+    # the memory is in world terms: turned by 90 degrees, the wall on the right is now behind
+    assert clear_ahead(body_frame(((0.4, 0.0, 0.0, 0.0),), (0.0, 0.0, math.pi / 2)), 0.25) == math.inf
+
+
+@pytest.mark.parametrize("wall_y, ahead, expected", [
+    (-0.45, (), MovCmd.SIDESTEP_RIGHT),                 # too far from the wall: step towards it
+    (-0.18, (), MovCmd.SIDESTEP_LEFT),                  # the feet would reach it: step away
+    (-0.30, (), MovCmd.FORWARD),                        # in the band: walk on
+    (-0.30, ((0.4, 0.0, 0.0, 0.05),), MovCmd.TURN_LEFT),   # a wall ahead: an inside corner, turn with it
+])
+def test_wall_following_holds_the_band_with_sidesteps_and_turns_at_corners(wall_y, ahead, expected):
+    clock = [0.0]
+    net = np3_network(lambda: clock[0], "wall_follow")
+    net.sense(pose=(0.0, 0.0, 0.0), echoes=_wall(wall_y) + ahead)
+    assert net.step()["move"] == expected
+
+
+def test_exploring_sets_a_goal_short_of_the_mapped_walls(spec):
+    metres = quantizer(M.XmitDataUsrc, "distance")
+    rig = np3(spec, task="explore")
+    for k in range(0, 360, 5):                                               # walls 1.5 m all round
+        rig.inject(0.1 + k / 400, MCP, data("USRC", metres.raw(1.5), VALUE, channel=k))
+    rig.run(11.0)                                                            # the 10 s re-plan saw the sweep
+    goal = rig.node.goal
+    x, y, _th = rig.node.odo.pose
+    assert goal is not None and math.hypot(goal[0] - x, goal[1] - y) > 0.3
+    assert math.hypot(*goal) < 1.5 - 0.1                                     # inside the walls, short of them

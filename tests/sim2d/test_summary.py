@@ -1,0 +1,20 @@
+"""The batch summary table: one row per run, PASS only when every expectation passed."""
+from __future__ import annotations
+
+from sim2d.summary import markdown
+
+
+def _metrics(name: str, seed: int, passed: list[bool], control: dict | None = None) -> dict:
+    return {"scenario": name, "seed": seed, "post": {"verdict": "OPERATIONAL"}, "distance_walked_m": 1.234,
+            "collisions": 0, "min_clearance_m": 0.25, "max_reaction_s": 0.412,
+            "nodes": {"NP3": {"control": control}} if control else {},
+            "notes": {"escape": {"count": 3}},
+            "expectations": [{"name": f"e{i}", "passed": p, "detail": ""} for i, p in enumerate(passed)]}
+
+
+def test_rows_sorted_with_pass_fail_and_key_metrics() -> None:
+    table = markdown([_metrics("b", 2, [True, False]), _metrics("a", 1, [True], {"reflexes": 2.0, "task": 30.4})])
+    lines = table.splitlines()
+    assert lines[2].startswith("| a | 1 | PASS | OPERATIONAL | 1.23 | 0 | 0.25 | 0.41 | 2/0/30 | escape=3 |")
+    assert lines[3].startswith("| b | 2 | FAIL |")
+    assert len(lines) == 4
