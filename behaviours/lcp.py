@@ -15,8 +15,10 @@ processing, for speed):
   foot is set down where the swing began. BLOCKED clears after a clean swing.
 - a JAC that stops answering: LEG_FLAGS.JAC_FAULT, OUT_OF_ORDER.
 - a JAC reporting OVERTEMP: LEG_FLAGS.OVERTEMP (the MMC slows the gait).
-The sole switch is read locally (seed 1.2.2): a foot without ground contact
-LCP_SETTLE_S after touchdown reports NO_GROUND and hovers at
+The sole switch is read locally (seed 1.2.2): a carrying foot without ground
+contact first searches down for the ground (up to LCP_GROUND_SEARCH_M below its
+set point: the body may stand on a foot that rests on a low obstacle); still
+without contact LCP_SETTLE_S after touchdown it reports NO_GROUND and hovers at
 LCP_NO_GROUND_Z_M instead of pushing down into the pit; the flag clears
 when the sole touches ground again.
 """
@@ -89,6 +91,7 @@ class LCP(PostMaster, Runtime, LcpSkeleton):
         self.failed = False                   # blocked again after the retry: leg drive failed
         self.touchdown = 0.0                  # when the foot last came down (end of a swing, or a stance began)
         self.lost_contact = 0.0               # the last time the sole switch was closed
+        self.search_z = 0.0                   # how far below its set point the carrying foot reaches for ground
         self.high_steps = 0                   # swings still lifted to the step limit after a block
         self.deferred: Segment | None = None  # a stance that waits for a re-planned swing to land
         self.poll_i = 0
@@ -143,6 +146,7 @@ class LCP(PostMaster, Runtime, LcpSkeleton):
         """The foot comes down: the ground-contact check starts; a clean step ends a block (seed 6.1)."""
         seg = self.seg
         self.touchdown = t
+        self.search_z = 0.0
         if seg is not None and seg.swing and not seg.blocked:
             self.flags &= ~_BLOCKED
             self.failed = False
@@ -167,14 +171,20 @@ class LCP(PostMaster, Runtime, LcpSkeleton):
         self.flags = (self.flags | _CONTACT) if contact else (self.flags & ~_CONTACT)
         swinging = seg is not None and seg.swing and not seg.done(t)
         self.flags = (self.flags | _SWINGING) if swinging else (self.flags & ~_SWINGING)
+        searched = self.search_z <= -T.LCP_GROUND_SEARCH_M + 1e-9
         if contact:
             self.flags &= ~_NO_GROUND
             self.lost_contact = t
+        elif self.carrying() and not self.flags & _NO_GROUND and not searched:
+            # reach down for the ground before calling it a pit (a sole switch only sees touch)
+            self.search_z = max(-T.LCP_GROUND_SEARCH_M, self.search_z - T.LCP_GROUND_SEARCH_M_S * period)
         elif (self.carrying() and t - max(self.touchdown, self.lost_contact) > T.LCP_SETTLE_S
               and not self.flags & _NO_GROUND):
             self.flags |= _NO_GROUND          # seed 1.2.2: the sole finds no ground (a pit)
             self.hw.note("no_ground", leg=self.leg)
         x, y, z = seg.at(t + period) if seg is not None else self.pos
+        if self.carrying() and not self.flags & _NO_GROUND:
+            z += self.search_z
         if self.flags & _NO_GROUND and self.carrying() and t - self.touchdown > T.LCP_SETTLE_S:
             z = max(z, T.LCP_NO_GROUND_Z_M)   # over a pit: no weight on this leg, the foot hovers
         self.pos = (x, y, z)

@@ -84,6 +84,10 @@ class Tuning:
     light_samples: int = T.NP3_LIGHT_SAMPLES
     light_min_spread_m: float = T.NP3_LIGHT_MIN_SPREAD_M
     light_probe_s: float = T.NP3_LIGHT_PROBE_S
+    light_clear_m: float = T.NP3_LIGHT_CLEAR_M
+    light_weave_deg: float = T.NP3_LIGHT_WEAVE_DEG
+    light_weave_s: float = T.NP3_LIGHT_WEAVE_S
+    light_detour_step_deg: float = T.NP3_LIGHT_DETOUR_STEP_DEG
     turn_rate_deg_s: float = T.NP3_DR_TURN_DEG_S   # turn on the spot (measured; nominal 20 deg per 0.8 s)
 
 
@@ -273,8 +277,13 @@ class TaskModule:
         self.reached: Any = None
         self.obstacle_until = -math.inf
         self.wall_at: float | None = None
+        self.detour_side = 0.0
+        self.weave = 0.0
+        self.weave_at: float | None = None
 
     def step(self, inputs: Mapping[str, Any], now: float) -> Outputs:
+        if self.task in ("seek_light", "avoid_light"):
+            self._sample(inputs.get("light"), now)    # every sample, also while a manoeuvre runs
         if self.plan is not None:
             v = self.plan.value(now)
             if v is not None:
@@ -354,6 +363,19 @@ class TaskModule:
             return self._run([(abs(math.degrees(angle)) / t.turn_rate_deg_s, turn), (1.0, FORWARD)], now)
         return FORWARD
 
+    def _sample(self, light: Any, now: float) -> None:
+        """seed 3.2.16: a new LSC sample (log lux at the dead-reckoned pose) refits the gradient; a fit that
+        fails (samples too close or in a line) keeps the last direction."""
+        if light is None or light[0] == self.light_seq:
+            return
+        self.light_seq = light[0]
+        self.samples = (self.samples + [light[1:]])[-self.t.light_samples:]
+        fit = light_gradient(self.samples, self.t.light_min_spread_m)
+        if fit is not None and self.gradient is None:
+            self.plan = None                          # the probe has done its job: head for the light now
+        self.gradient = fit or self.gradient
+        import sys; print('DBG', round(now,1), [round(v,2) for v in light[1:]], self.gradient and round(math.degrees(math.atan2(self.gradient[1],self.gradient[0]))), file=sys.stderr)  # DBG
+
     def _seek_light(self, i: Mapping[str, Any], now: float) -> MovCmd:
         return self._light(i, now, sign=1.0)
 
@@ -361,22 +383,56 @@ class TaskModule:
         return self._light(i, now, sign=-1.0)
 
     def _light(self, i: Mapping[str, Any], now: float, sign: float) -> MovCmd:
-        """Up (or down) the light gradient fitted over the last samples; probe in an L while it is unknown."""
+        """Up (or down) the light gradient fitted over the last samples; probe in an L while it is unknown.
+
+        The LSC reads log lux in 3.6 % steps every ~2.5 s, so the fit needs samples
+        spread across the way as well as along it: the robot weaves, alternately
+        light_weave_deg either side of the gradient every light_weave_s, and the
+        fit over the latest samples never degenerates into a line (a failed fit
+        keeps the last direction). Each leg's heading is the one nearest the
+        target whose corridor the echo memory shows clear: an obstacle across
+        the way is walked round along its edge (bug-style, seed 5.1.2).
+        """
         t = self.t
-        light, pose = i.get("light"), i.get("pose")
-        if light is not None and light[0] != self.light_seq:
-            self.light_seq = light[0]
-            self.samples = (self.samples + [light[1:]])[-t.light_samples:]
-            self.gradient = light_gradient(self.samples, t.light_min_spread_m)
+        pose = i.get("pose")
         ir = _seen(i.get("ir"))
-        if any(d is not None for d in ir):
-            self.obstacle_until = now + t.light_probe_s / 2    # after an obstacle, walk on past it first
-        if self.gradient is None or pose is None or now < self.obstacle_until:
+        if self.gradient is None or pose is None:
+            if any(d is not None for d in ir):
+                self.obstacle_until = now + t.light_probe_s / 2    # after an obstacle, walk on past it first
             if now < self.obstacle_until:
                 return FORWARD
             return self._run([(t.light_probe_s, FORWARD), (90.0 / t.turn_rate_deg_s, LEFT)], now)
         gx, gy = self.gradient
-        return self._steer(pose, math.atan2(sign * gy, sign * gx))
+        bearing = math.atan2(sign * gy, sign * gx)
+        flip = self.weave_at is None or now >= self.weave_at
+        if flip:
+            self.weave_at = now + t.light_weave_s
+            self.weave = -self.weave or 1.0
+        target = self._detour(i, pose, bearing + self.weave * math.radians(t.light_weave_deg))
+        err = heading_error(pose, target)
+        if flip and abs(err) > math.radians(t.heading_tol_deg) / 4:     # each leg starts on its heading
+            return self._run([(abs(math.degrees(err)) / t.turn_rate_deg_s, LEFT if err > 0 else RIGHT)], now)
+        return self._steer(pose, target)
+
+    def _detour(self, i: Mapping[str, Any], pose: tuple[float, float, float], bearing: float) -> float:
+        """seed 5.1.2: the heading closest to `bearing` whose corridor (body and legs) the echoes of the last
+        seconds leave clear for t.light_clear_m; once round an obstacle one side is kept (no dithering)."""
+        t = self.t
+        echoes = i.get("echoes")
+        if not echoes:
+            self.detour_side = 0.0
+            return bearing
+        step = math.radians(t.light_detour_step_deg)
+        sides = (self.detour_side,) if self.detour_side else (1.0, -1.0)
+        if sides == (1.0, -1.0) and heading_error(pose, bearing) < 0:
+            sides = (-1.0, 1.0)                            # look first on the side the robot already faces
+        for k in range(int(round(math.pi / step)) + 1):
+            for side in sides:
+                h = bearing + side * k * step
+                if clear_ahead(body_frame(echoes, (pose[0], pose[1], h)), t.avoid_half_width_m) >= t.light_clear_m:
+                    self.detour_side = side if k else 0.0
+                    return h
+        return bearing
 
 
 class OrientModule:
