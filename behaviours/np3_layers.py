@@ -88,6 +88,7 @@ class Tuning:
     light_weave_deg: float = T.NP3_LIGHT_WEAVE_DEG
     light_weave_s: float = T.NP3_LIGHT_WEAVE_S
     light_detour_step_deg: float = T.NP3_LIGHT_DETOUR_STEP_DEG
+    light_detour_hold_s: float = T.NP3_LIGHT_DETOUR_HOLD_S
     turn_rate_deg_s: float = T.NP3_DR_TURN_DEG_S   # turn on the spot (measured; nominal 20 deg per 0.8 s)
 
 
@@ -231,12 +232,16 @@ def clear_ahead(points: list[Point], half_width_m: float) -> float:
     return min((bx for bx, by, _seen, arc in points if bx > 0 and abs(by) + arc < half_width_m), default=math.inf)
 
 
-def light_gradient(samples: list[tuple[float, float, float]], min_spread: float) -> tuple[float, float] | None:
+def light_gradient(samples: list[tuple[float, float, float]], min_spread: float,
+                   prior: tuple[float, float] | None = None) -> tuple[float, float] | None:
     """Least-squares plane L = a + gx x + gy y through (x, y, L) samples; None while they are too close together.
 
     The LSC sits on the body's centre and reads the same in every heading, so
     the direction to the light only shows in how the reading changes with the
-    position (dead reckoning): the plane's slope points up the gradient.
+    position (dead reckoning): the plane's slope points up the gradient. With a
+    `prior` (the last fit) the slope is pulled towards it (ridge, weight of samples
+    min_spread apart): samples along a line then still correct the slope along
+    it and keep the prior across it.
     """
     n = len(samples)
     if n < 3:
@@ -249,6 +254,11 @@ def light_gradient(samples: list[tuple[float, float, float]], min_spread: float)
     sxy = sum((s[0] - mx) * (s[1] - my) for s in samples)
     sxl = sum((s[0] - mx) * (s[2] - ml) for s in samples)
     syl = sum((s[1] - my) * (s[2] - ml) for s in samples)
+    if prior is not None and n >= 2:
+        lam = n * (min_spread / 2) ** 2
+        sxx, syy, sxl, syl = sxx + lam, syy + lam, sxl + lam * prior[0], syl + lam * prior[1]
+        det = sxx * syy - sxy * sxy
+        return (syy * sxl - sxy * syl) / det, (sxx * syl - sxy * sxl) / det
     det = sxx * syy - sxy * sxy
     # the smaller spread (eigenvalue of the scatter matrix) must reach min_spread^2 per sample
     tr = sxx + syy
@@ -278,6 +288,7 @@ class TaskModule:
         self.obstacle_until = -math.inf
         self.wall_at: float | None = None
         self.detour_side = 0.0
+        self.detour_until = -math.inf
         self.weave = 0.0
         self.weave_at: float | None = None
 
@@ -370,11 +381,10 @@ class TaskModule:
             return
         self.light_seq = light[0]
         self.samples = (self.samples + [light[1:]])[-self.t.light_samples:]
-        fit = light_gradient(self.samples, self.t.light_min_spread_m)
+        fit = light_gradient(self.samples, self.t.light_min_spread_m, self.gradient)
         if fit is not None and self.gradient is None:
             self.plan = None                          # the probe has done its job: head for the light now
         self.gradient = fit or self.gradient
-        import sys; print('DBG', round(now,1), [round(v,2) for v in light[1:]], self.gradient and round(math.degrees(math.atan2(self.gradient[1],self.gradient[0]))), file=sys.stderr)  # DBG
 
     def _seek_light(self, i: Mapping[str, Any], now: float) -> MovCmd:
         return self._light(i, now, sign=1.0)
@@ -408,19 +418,21 @@ class TaskModule:
         if flip:
             self.weave_at = now + t.light_weave_s
             self.weave = -self.weave or 1.0
-        target = self._detour(i, pose, bearing + self.weave * math.radians(t.light_weave_deg))
+        target = self._detour(i, pose, bearing + self.weave * math.radians(t.light_weave_deg), now)
         err = heading_error(pose, target)
         if flip and abs(err) > math.radians(t.heading_tol_deg) / 4:     # each leg starts on its heading
             return self._run([(abs(math.degrees(err)) / t.turn_rate_deg_s, LEFT if err > 0 else RIGHT)], now)
         return self._steer(pose, target)
 
-    def _detour(self, i: Mapping[str, Any], pose: tuple[float, float, float], bearing: float) -> float:
+    def _detour(self, i: Mapping[str, Any], pose: tuple[float, float, float], bearing: float, now: float) -> float:
         """seed 5.1.2: the heading closest to `bearing` whose corridor (body and legs) the echoes of the last
-        seconds leave clear for t.light_clear_m; once round an obstacle one side is kept (no dithering)."""
+        seconds leave clear for t.light_clear_m; the side a detour took is kept for t.light_detour_hold_s
+        after the last blocked heading (round an obstacle on one side, no dithering at its corner)."""
         t = self.t
         echoes = i.get("echoes")
-        if not echoes:
+        if now > self.detour_until:
             self.detour_side = 0.0
+        if not echoes:
             return bearing
         step = math.radians(t.light_detour_step_deg)
         sides = (self.detour_side,) if self.detour_side else (1.0, -1.0)
@@ -430,7 +442,8 @@ class TaskModule:
             for side in sides:
                 h = bearing + side * k * step
                 if clear_ahead(body_frame(echoes, (pose[0], pose[1], h)), t.avoid_half_width_m) >= t.light_clear_m:
-                    self.detour_side = side if k else 0.0
+                    if k:
+                        self.detour_side, self.detour_until = side, now + t.light_detour_hold_s
                     return h
         return bearing
 

@@ -97,12 +97,14 @@ NP3_EXPLORE_TURN_S = 2.4      # ... turning this long
 NP3_GOAL_REACHED_M = 0.4      # a goal this close (dead reckoning) is reached
 NP3_HEADING_TOL_DEG = 20.0    # steering: turn on the spot while the goal is further off the axis than this
 NP3_LIGHT_SAMPLES = 8         # light gradient: plane fitted through this many (pose, log lux) samples
-NP3_LIGHT_MIN_SPREAD_M = 0.15 # ... spread at least this far in both directions
+NP3_LIGHT_MIN_SPREAD_M = 0.15 # ... spread at least this far in both directions for a first fit (one L); later
+                              # fits lean on the last one with the weight of samples this far apart (ridge)
 NP3_LIGHT_PROBE_S = 6.0       # without a gradient: walk this long, then turn a quarter
-NP3_LIGHT_WEAVE_DEG = 30.0    # with a gradient: weave this far either side of it ...
-NP3_LIGHT_WEAVE_S = 6.0       # ... changing side this often (the fit needs samples spread across the way)
+NP3_LIGHT_WEAVE_DEG = 20.0    # with a gradient: weave this far either side of it ...
+NP3_LIGHT_WEAVE_S = 8.0       # ... changing side this often (the fit needs samples spread across the way)
 NP3_LIGHT_CLEAR_M = 0.6       # ... on the heading nearest the target with this much clear in the echo memory,
 NP3_LIGHT_DETOUR_STEP_DEG = 20.0  # ... tried in steps this wide either side (bug-style round an obstacle)
+NP3_LIGHT_DETOUR_HOLD_S = 10.0   # ... keeping a detour's side this long after the last blocked heading
 NP3_MAP_SIZE_M = 12.0         # topological map: a square this wide around the start ...
 NP3_MAP_CELL_M = 0.1          # ... in cells this wide
 NP3_SONAR_BEAM_DEG = 15.0     # width a sonar echo is spread over on the map (40 kHz transducer cone)

@@ -11,7 +11,7 @@ from arachnae_proto.enums import MmcError, MovCmd, RangeStatus, RecordKind, Tpsc
 from arachnae_proto.network import ADDRESS_OF
 from behaviours import tuning as T
 from behaviours.np3 import DeadReckoning, decode
-from behaviours.np3_layers import body_frame, clear_ahead, light_gradient, np3_network, wall_beside
+from behaviours.np3_layers import TaskModule, Tuning, body_frame, clear_ahead, light_gradient, np3_network, wall_beside
 from behaviours.units import quantizer
 from tests.behaviours.rig import Rig
 
@@ -168,6 +168,47 @@ def test_dead_reckoning_and_light_gradient():
     gx, gy = light_gradient(samples, 0.25)
     assert gx == pytest.approx(0.0, abs=1e-9) and gy == pytest.approx(0.5)
     assert light_gradient([(0, 0, 1.0), (1, 0, 1.1), (2, 0, 1.2)], 0.25) is None
+
+
+def test_a_later_light_fit_corrects_along_the_way_and_keeps_the_prior_across_it():
+    # samples on a line along x: alone they fit no plane; with the last fit as prior the slope along x
+    # follows the samples (towards 0.2) and the slope across (y) stays the prior's
+    line = [(0.1 * k, 0.0, 1.0 + 0.02 * k) for k in range(8)]
+    assert light_gradient(line, 0.15) is None
+    gx, gy = light_gradient(line, 0.15, prior=(0.0, 0.5))
+    assert 0.1 < gx < 0.2 and gy == pytest.approx(0.5)
+
+
+def test_seek_light_samples_while_probing_and_stops_the_probe_once_the_gradient_is_known():
+    task = TaskModule("seek_light", Tuning())
+    brighter_up = lambda x, y: 1.0 + 0.2 * y          # noqa: E731
+    path = [(0.0, 0.0), (0.3, 0.0), (0.6, 0.0), (0.6, 0.0), (0.6, 0.3), (0.6, 0.6)]
+    now, probing = 0.0, None
+    for seq, (x, y) in enumerate(path, 1):
+        out = task.step({"light": (seq, x, y, brighter_up(x, y)), "pose": (x, y, 0.0)}, now)
+        probing = probing if probing is not None else task.plan
+        now += 2.5
+    assert probing is not None and len(task.samples) == len(path)   # every sample counted, also during the probe
+    gx, gy = task.gradient
+    assert math.degrees(math.atan2(gy, gx)) == pytest.approx(90.0, abs=1.0)
+    assert task.plan is None or task.plan is not probing                 # the probe was dropped
+    assert out["move"] in (MovCmd.TURN_LEFT, MovCmd.FORWARD)           # ... for the light (+y: turn left)
+
+
+def test_seek_light_walks_round_an_obstacle_on_one_side():
+    t = Tuning()
+    task = TaskModule("seek_light", t)
+    # a wall 0.4 m ahead across the light's bearing (+x), 1.2 m long
+    wall = tuple((0.4, -0.6 + 0.05 * k, 0.0, 0.0) for k in range(25))
+    h1 = task._detour({"echoes": wall}, (0.0, 0.0, 0.0), 0.0, 0.0)
+    assert abs(math.degrees(h1)) >= 40                                  # not into the wall
+    assert clear_ahead(body_frame(wall, (0.0, 0.0, h1)), t.avoid_half_width_m) >= t.light_clear_m
+    side = math.copysign(1.0, h1)
+    # a little later the target swings to the other side of the bearing: the detour keeps its side
+    h2 = task._detour({"echoes": wall}, (0.0, 0.0, h1), -side * math.radians(t.light_weave_deg), 2.0)
+    assert math.copysign(1.0, h2) == side
+    # nothing in the way: straight for the target
+    assert task._detour({"echoes": ()}, (0.0, 0.0, 0.0), 0.3, 20.0) == 0.3
 
 
 def test_dead_reckoning_counts_sidesteps():
