@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from arachnae_proto import messages as M
 from arachnae_proto.enums import Alert, Direction, Gait, MmcError, RangeStatus, RecordKind, SscMessage
-from arachnae_proto.network import ADDRESS_OF, NODES
+from arachnae_proto.network import ADDRESS_OF, BROADCAST, NODES
 from arachnae_proto.skeletons.mcp import McpSkeleton
 
 from behaviours import tuning as T
@@ -84,8 +84,9 @@ class MCP(PostMaster, Runtime, McpSkeleton):
         self.halted = False
         second = names_line("MISSING ", v.missing) if v.missing else "READY"
         self.tell("operator", lcd_lines(f"POST {v.verdict}", second), None)
-        # CHOICE: INIT to the NP3 after a passed POST starts navigation with a zeroed world model (seed 3.2.3)
-        self.request(ADDRESS_OF["NP3"], M.Init())
+        # seed 3.2.3: INIT via broadcasting (0xFF) on the first-level bus;
+        # CHOICE: sent after a passed POST, it starts the NP3's navigation with a zeroed world model
+        self.request(BROADCAST, M.Init())
         for (source, channel), value in sorted(self.faults.items()):
             # the NP3 starts afresh: what is known to be broken still is (6.2)
             self.request(ADDRESS_OF["NP3"], M.Data(address=source, kind=_STATUS, channel=channel, value=value))

@@ -25,7 +25,7 @@ from typing import Any, Callable
 
 from arachnae_proto.frame import OVERHEAD, Frame, build
 from arachnae_proto.messages import Message
-from arachnae_proto.network import BUSES, NODES
+from arachnae_proto.network import BROADCAST, BUSES, NODES
 
 from behaviours.hardware import Hardware
 from behaviours.netconfig import Config
@@ -147,7 +147,10 @@ class Runtime:
         req = link.current
         if req is None or req.serial != serial:
             return
-        link.frame = self.send(req.dst, req.msg)  # type: ignore[attr-defined]
+        if req.dst == BROADCAST:                  # seed 3.2.1: 0xFF, every node of the bus
+            link.frame = self.broadcast(link.bus, req.msg)  # type: ignore[attr-defined]
+        else:
+            link.frame = self.send(req.dst, req.msg)  # type: ignore[attr-defined]
 
     def _timeout(self, link: MasterLink, serial: int) -> None:
         req = link.current

@@ -5,7 +5,7 @@ import pytest
 
 from arachnae_proto import messages as M
 from arachnae_proto.enums import Direction, Gait
-from arachnae_proto.network import ADDRESS_OF as A
+from arachnae_proto.network import ADDRESS_OF as A, BROADCAST
 
 from tests.behaviours.rig import Rig
 
@@ -41,7 +41,7 @@ def post(spec, **kw) -> Rig:
 def test_all_present_is_operational_and_starts_the_np3(spec):
     rig = post(spec)
     assert rig.node.verdict.verdict == "OPERATIONAL"
-    assert [f.dst for _, f in rig.frames(M.Init)] == [A["NP3"]]        # seed 3.2.3: navigation starts
+    assert [f.dst for _, f in rig.frames(M.Init)] == [BROADCAST]       # seed 3.2.3: INIT via broadcasting starts navigation
     assert {f.dst for _, f in rig.frames(M.IdReq)} == {A[s] for s in ("NP3", "MMC", "SPU", "SSC", "APU/SDF", "UIC/RCP", "RLC")}
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from arachnae_proto import messages as M
 from arachnae_proto.enums import Alert, Direction, Gait, MmcError, RangeStatus, RecordKind, SscMessage, TpscContact
-from arachnae_proto.network import ADDRESS_OF as A
+from arachnae_proto.network import ADDRESS_OF as A, BROADCAST
 
 from behaviours import tuning as T
 from tests.behaviours.rig import Rig
@@ -161,7 +161,7 @@ def test_post_again_at_run_time_from_the_uic(spec):
     rig.run(5.0)
     assert len(rig.frames(M.IdReq)) == ids_before + len(FIRST)
     assert len(notes(rig, "post_verdict")) == 2
-    inits = rig.frames(M.Init, NP3)
+    inits = rig.frames(M.Init, BROADCAST)            # seed 3.2.3: INIT via broadcasting
     assert len(inits) == 2 and inits[1][0] > 3.0
     replay = [f.message for t, f in rig.frames(M.Data, NP3) if t > inits[1][0] and f.message.address == A["IRRC"]]
     assert [(d.kind, d.value) for d in replay] == [(RecordKind.STATUS, RangeStatus.UNRELIABLE)]
