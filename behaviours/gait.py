@@ -93,7 +93,7 @@ class Gait:
         self.paused = False
         self.gait_switches = 0
         self.pause_s = 0.0
-        self.dt = 0.02                               # the last clock step (gait seconds)
+        self.dt = T.MMC_CONTROL_S                    # the last clock step (gait seconds); the MMC steps at this period
         self.swing_lift = p.lift                     # how high the next swings lift (raised near an obstacle)
         self.plans = {leg: LegPlan(pos=p.neutral_foot(leg)) for leg in p.legs}
         self._set_pattern(TRIPOD)

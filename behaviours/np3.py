@@ -32,7 +32,7 @@ from behaviours import tuning as T
 from behaviours.np3_layers import AVOIDANCE, REFLEXES, np3_network
 from behaviours.runtime import Runtime
 from behaviours.topomap import OCCUPIED, OccupancyGrid, Reading, TopoMap, ray_cells
-from behaviours.units import Quantizer, quantizer
+from behaviours.units import XMIT_DATA_OF, Quantizer, from_record_byte, quantizer
 
 _VALUE, _ALARM, _STATUS = int(RecordKind.VALUE), int(RecordKind.ALARM), int(RecordKind.STATUS)
 _IR_BAD = {int(RangeStatus.UNRELIABLE), int(RangeStatus.OUT_OF_ORDER)}
@@ -40,18 +40,15 @@ _NO_GROUND, _BLOCKED = int(MmcError.NO_GROUND), int(MmcError.LEG_DRIVE_BLOCKED)
 _STOP, _FORWARD, _BACKWARD = int(MovCmd.STOP), int(MovCmd.FORWARD), int(MovCmd.BACKWARD)
 _LEFT, _RIGHT = int(MovCmd.TURN_LEFT), int(MovCmd.TURN_RIGHT)
 _SIDE_L, _SIDE_R = int(MovCmd.SIDESTEP_LEFT), int(MovCmd.SIDESTEP_RIGHT)
-# each source role's XMIT_DATA layout and the field whose encoding its records carry (spec messages)
-_XMIT_DATA = {m.SENDERS[0]: m for m in M.MESSAGES if m.SEED_NAME == "XMIT_DATA" and m is not M.XmitData}
+# the field of each source role's XMIT_DATA layout whose encoding its records carry (spec messages)
 _FIELD = {"IRRC": "center", "ISC": "longitudinal", "LSC": "brightness", "PSC": "voltage", "USRC": "distance"}
-_Q: dict[str, Quantizer] = {role: quantizer(_XMIT_DATA[role], f) for role, f in _FIELD.items()}
+_Q: dict[str, Quantizer] = {role: quantizer(XMIT_DATA_OF[role], f) for role, f in _FIELD.items()}
 
 
 def decode(role: str, value: int) -> float:
     """A record's value byte in the physical unit of `role`'s XMIT_DATA field (signed fields: two's complement)."""
     q = _Q[role]
-    if q.lo < 0 and value > 127:
-        value -= 256
-    return q.phys(value)
+    return q.phys(from_record_byte(value, q.lo < 0))
 
 
 class DeadReckoning:

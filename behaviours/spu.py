@@ -26,10 +26,8 @@ from behaviours import tuning as T
 from behaviours.post import PostMaster
 from behaviours.runtime import slaves_of
 from behaviours.sensors import ABOVE, BELOW, BEYOND, AfterReplies, AlarmLimit, limit_in
-from behaviours.units import quantizer
+from behaviours.units import XMIT_DATA_OF, quantizer, record_byte
 
-# each sensor role's XMIT_DATA reply (the spec's XMIT_DATA_<role> layouts)
-REPLY_OF = {m.SENDERS[0]: m for m in M.MESSAGES if m.SEED_NAME == "XMIT_DATA" and m is not M.XmitData}
 # each sensor role's STATUS_ACK layout; the range sensors are the ones with UNRELIABLE (3.2.11, 3.2.13)
 STATUS_OF = {role: cls for cls in (M.StatusAckRange, M.StatusAckOrder) for role in cls.SENDERS}
 RANGE = tuple(M.StatusAckRange.SENDERS)
@@ -49,7 +47,7 @@ def channels(role: str, msg: Any) -> dict[int, int]:
         return {int(IscAxis.LONGITUDINAL): msg.longitudinal, int(IscAxis.TRANSVERSE): msg.transverse}
     if role == "TSC":
         return {msg.channel: msg.temperature}
-    field = REPLY_OF[role].FIELDS[0].name
+    field = XMIT_DATA_OF[role].FIELDS[0].name
     return {0: getattr(msg, field)}
 
 
@@ -140,7 +138,7 @@ class SPU(PostMaster, AfterReplies, SpuSkeleton):
             return
         role = cycle[self.cycle_i % len(cycle)]
         self.cycle_i += 1
-        self.request(self.sensors[role], M.XmitData(), (REPLY_OF[role],),
+        self.request(self.sensors[role], M.XmitData(), (XMIT_DATA_OF[role],),
                      lambda s, m, role=role: (self.got(role, m, False), self.poll()),
                      lambda role=role: (self.missed(role), self.poll()))
 
@@ -157,17 +155,17 @@ class SPU(PostMaster, AfterReplies, SpuSkeleton):
 
     def on_data_rdy(self, src: int, msg: M.DataRdy) -> None:
         role = NODES[src][1]
-        if role not in REPLY_OF or role not in self.live:
+        if role not in XMIT_DATA_OF or role not in self.live:
             return
         if role in self.free_run:
             if self.status.get(role, _IN_ORDER) != _IN_ORDER:
                 self.counts["ignored"] += 1       # seed 6.2: an untrustworthy sensor's data is ignored
                 return
-            self.request(src, M.XmitData(), (REPLY_OF[role],), lambda s, m, role=role: self.got(role, m, False),
+            self.request(src, M.XmitData(), (XMIT_DATA_OF[role],), lambda s, m, role=role: self.got(role, m, False),
                          lambda role=role: self.missed(role), urgent=True)
             return
         event = role != "TPSC"                     # anything else announces an alarm or a status change
-        self.request(src, M.XmitData(), (REPLY_OF[role],), lambda s, m, role=role: self.got(role, m, event),
+        self.request(src, M.XmitData(), (XMIT_DATA_OF[role],), lambda s, m, role=role: self.got(role, m, event),
                      lambda role=role: self.missed(role), urgent=True)
         if role in RANGE:                          # urgent: goes before the XMIT_DATA just queued
             self.request(src, M.StatusReq(), (STATUS_OF[role],), lambda s, m, role=role: self.set_status(role, m.status),
@@ -205,7 +203,7 @@ class SPU(PostMaster, AfterReplies, SpuSkeleton):
     # --- records to the NP3 through the MCP (seed 3.2.2) -----------------------------------
     def record(self, role: str, kind: int, channel: int, value: int) -> None:
         src = self.sensors[role]
-        rec = (src, kind, channel, value & 0xFF)             # signed values as their two's complement byte
+        rec = (src, kind, channel, record_byte(value))       # signed values as their two's complement byte
         self.counts[_KIND_NAME[kind]] += 1
         if kind != _STATUS:
             self.values[role] = self.values.get(role, 0) + 1

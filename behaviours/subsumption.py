@@ -354,14 +354,7 @@ class Network:
         return self.traces[actuator]
 
 
-# --------------------------------------------------------------------------- the NP3's network
-def np3_network(clock: Clock, task: str = "forward", tuning: Any = None) -> Network:
-    """The NP3's layered network, declared in behaviours.np3_layers (kept there: its layers and tasks)."""
-    from behaviours.np3_layers import np3_network as build
-    return build(clock, task, tuning)
-
-
 __all__ = [
-    "Behaviour", "FunctionModule", "ReflexModule", "Plan", "Network", "ControlTrace", "Interval", "np3_network",
+    "Behaviour", "FunctionModule", "ReflexModule", "Plan", "Network", "ControlTrace", "Interval",
     "NONE_LAYER",
 ]

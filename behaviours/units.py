@@ -12,8 +12,23 @@ import bisect
 import math
 from typing import Callable
 
+from arachnae_proto import messages as _M
 from arachnae_proto.convert import LinearConv, LogConv
 from arachnae_proto.messages import Message
+
+# each sensor role's own XMIT_DATA layout (the spec's XMIT_DATA_<role> messages)
+XMIT_DATA_OF: dict[str, type[Message]] = {
+    m.SENDERS[0]: m for m in _M.MESSAGES if m.SEED_NAME == "XMIT_DATA" and m is not _M.XmitData}
+
+
+def record_byte(raw: int) -> int:
+    """A raw field value as a record's value byte (spec XMIT_RECORD: signed fields as two's complement)."""
+    return raw & 0xFF
+
+
+def from_record_byte(value: int, signed: bool) -> int:
+    """The raw field value a record's value byte carries (inverse of record_byte)."""
+    return value - 256 if signed and value > 127 else value
 
 
 class Quantizer:

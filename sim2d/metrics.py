@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+from bisect import bisect_left
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -36,13 +37,17 @@ def note_counts(notes: list[tuple[float, str, str, dict[str, Any]]],
         e = out.setdefault(event, {"count": 0, "first_s": round(t, 6), "last_s": round(t, 6)})
         e["count"] += 1
         e["last_s"] = round(t, 6)
+    walked = [0.0]                         # path length up to each pose sample, computed once
+    for a, b in zip(poses, poses[1:]):
+        walked.append(walked[-1] + math.dist(a[1:3], b[1:3]))
+    times = [p[0] for p in poses]
     for e in out.values():
-        after = [(x, y) for t, x, y, _th in poses if t >= e["first_s"]]
-        e["walked_after_m"] = round(sum(math.dist(a, b) for a, b in zip(after, after[1:])), 4)
+        i = bisect_left(times, e["first_s"])
+        e["walked_after_m"] = round(walked[-1] - walked[i], 4) if i < len(times) else 0.0
     return dict(sorted(out.items()))
 
 
-def node_metrics(nodes: dict[str, Any], now: float) -> dict[str, Any]:
+def node_metrics(nodes: dict[str, Any]) -> dict[str, Any]:
     """What each node reports about itself on its debug port at the end (`debug_metrics()`, optional)."""
     out = {}
     for short, node in nodes.items():
@@ -117,7 +122,7 @@ def build_metrics(sim: "Simulation") -> dict[str, Any]:
         "notes": note_counts(sim.notes, sim.poses),
         "sound": sound_metrics(sim),             # sim2d.level0_io: sound events, final heading error
         "rcp": rcp_metrics(sim),                 # keys typed on the RCP console
-        "nodes": node_metrics(sim.nodes, dur),
+        "nodes": node_metrics(sim.nodes),
         "motion": motion_metrics(sim),           # sim2d.gait_metrics: body-frame motion per (gait, MOVE)
         **nav_metrics(sim),                      # sim2d.nav_metrics: coverage, wall_band (scenario `measure:`)
         "trace_hash": trace_hash(sim.frames, sim.poses),

@@ -1,7 +1,6 @@
 """LCP (seed 3.2.10, 6.1): swing profile, blocked-leg reflex, no ground, JAC faults and over-temperature."""
 from __future__ import annotations
 
-import math
 
 import pytest
 

@@ -7,7 +7,8 @@ import pytest
 
 from arachnae_proto.enums import MovCmd
 from behaviours.np3_layers import AVOIDANCE, REFLEXES, TASK
-from behaviours.subsumption import NONE_LAYER, FunctionModule, Network, np3_network
+from behaviours.np3_layers import np3_network
+from behaviours.subsumption import NONE_LAYER, FunctionModule, Network
 
 
 class FakeClock:
