@@ -101,7 +101,8 @@ def _leaves(*names: str) -> dict[str, Any]:
     return _obj({n: _VALUE for n in names})
 
 
-_VALUE: dict[str, Any] = {"type": ["number", "string", "boolean", "null", "array"]}   # a leaf metric
+_VALUE: dict[str, Any] = {"type": ["number", "boolean", "null", "array"]}   # a leaf metric (text ones say so)
+_TEXT: dict[str, Any] = {"type": ["string", "null"]}
 _FREE: dict[str, Any] = {"type": "object"}      # a node's own debug-port figures (debug_metrics()): any keys
 
 
@@ -114,14 +115,15 @@ def metrics_schema(spec: Any, measured: Sequence[str] = ()) -> dict[str, Any]:
     bus = _leaves("load", "frames", "bytes", "collisions", "lost", "corrupted", "delayed")
     layer = _leaves("buses", "frames", "lost", "corrupted", "load_mean", "load_max")
     return _obj({
-        **{k: _VALUE for k in ("scenario", "seed", "duration_s", "distance_walked_m", "displacement_m", "final_pose",
+        "scenario": _TEXT, "trace_hash": _TEXT,
+        **{k: _VALUE for k in ("seed", "duration_s", "distance_walked_m", "displacement_m", "final_pose",
                                "collisions", "min_clearance_m", "blocked_leg_events", "pit_events", "fell",
                                "tilt_events", "max_tilt_deg", "reach_time_s", "entered_forbidden_s", "moves",
-                               "reaction_latencies_s", "max_reaction_s", "frames", "frame_loss", "frames_corrupted",
-                               "trace_hash")},
+                               "reaction_latencies_s", "max_reaction_s", "frames", "frame_loss", "frames_corrupted")},
         "battery": _leaves("v_min", "v_mean", "v_final", "emf_final_v", "i_mean_a", "i_max_a", "charge_used_ah",
                            "psc_mean_v", "psc_mean_min_v", "psc_level_min_v", "psc_alarms", "battery_low"),
-        "post": _leaves("verdict", "missing", "reasons", "time_s"),
+        "post": _obj({"verdict": {"enum": [*spec.post.verdicts, None]}, "missing": _VALUE, "reasons": _VALUE,
+                      "time_s": _VALUE}),
         "buses": _obj({name: bus for name in spec.buses}),
         "bus_layers": _obj({str(level): layer for level in sorted({b.level for b in spec.buses.values()})}),
         "notes": {"type": "object", "additionalProperties": _leaves("count", "first_s", "last_s", "walked_after_m")},
@@ -137,6 +139,12 @@ def metrics_schema(spec: Any, measured: Sequence[str] = ()) -> dict[str, Any]:
 
 def metric_path_problem(schema: dict[str, Any], path: str) -> str | None:
     """Why `path` ('notes.escape.count') can never name a metric of `schema`, or None when it can."""
+    found = metric_node(schema, path)
+    return found if isinstance(found, str) else None
+
+
+def metric_node(schema: dict[str, Any], path: str) -> dict[str, Any] | str | None:
+    """The schema of the metric at `path`, None below a node's own figures (any shape), or why there is none."""
     node = schema
     done: list[str] = []
     for part in path.split("."):
@@ -152,7 +160,7 @@ def metric_path_problem(schema: dict[str, Any], path: str) -> str | None:
             return f"{where} has no {part!r} (one of {known})"
         node = nxt
         done.append(part)
-    return None
+    return node
 
 
 def build_metrics(sim: "Simulation") -> dict[str, Any]:
