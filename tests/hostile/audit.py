@@ -177,43 +177,35 @@ def dump(doc: Any) -> str:
 
 
 # -- surfaces ---------------------------------------------------------------------------------------
-def scenario_probes(work: Path, files: list[str], spec: Any) -> Iterator[Probe]:
-    """Every mutation of every node of the given scenario files, loaded as `sim run` loads them."""
-    from sim2d.scenario import load_scenario
+def _file_probes(surface: str, work: Path, bases: list[Path], load: Callable[[Path], Any]) -> Iterator[Probe]:
+    """Every mutation of every node of each base file, written beside it in a copy of scenarios/ (so its
+    includes resolve) and given to `load`, as the command would."""
     root = work / "scenarios"
     if not root.exists():
         shutil.copytree(SCENARIOS, root)
-    for name in files:
-        doc = yaml.safe_load((SCENARIOS / name).read_text(encoding="utf-8"))
+    for base in bases:
+        doc = yaml.safe_load(base.read_text(encoding="utf-8"))
+        folder = root / base.parent.relative_to(SCENARIOS)
         for i, (label, mutant, bad) in enumerate(doc_mutants(doc)):
-            path = root / f"audit_{Path(name).stem}_{i}.yaml"
-
-            def run(path=path, text=dump(mutant)):
+            def run(path=folder / f"audit_{base.stem}_{i}.yaml", text=dump(mutant)):
                 path.write_text(text, encoding="utf-8")
                 try:
-                    load_scenario(path, spec)
+                    load(path)
                 finally:
                     path.unlink()
-            yield Probe("scenario", f"{name} {label}", run, bad)
+            yield Probe(surface, f"{base.name} {label}", run, bad)
+
+
+def scenario_probes(work: Path, files: list[str], spec: Any) -> Iterator[Probe]:
+    """Scenario files, loaded as `sim run` loads them."""
+    from sim2d.scenario import load_scenario
+    yield from _file_probes("scenario", work, [SCENARIOS / f for f in files], lambda p: load_scenario(p, spec))
 
 
 def sweep_probes(work: Path, spec: Any) -> Iterator[Probe]:
+    """Sweep files, loaded as `sim sweep` loads them."""
     from sim2d.sweep import load_sweep
-    root = work / "scenarios"
-    if not root.exists():
-        shutil.copytree(SCENARIOS, root)
-    for base in sorted((SCENARIOS / "sweeps").glob("*.yaml")):
-        doc = yaml.safe_load(base.read_text(encoding="utf-8"))
-        for i, (label, mutant, bad) in enumerate(doc_mutants(doc)):
-            path = root / "sweeps" / f"audit_{base.stem}_{i}.yaml"
-
-            def run(path=path, text=dump(mutant)):
-                path.write_text(text, encoding="utf-8")
-                try:
-                    load_sweep(path, spec)
-                finally:
-                    path.unlink()
-            yield Probe("sweep", f"{base.name} {label}", run, bad)
+    yield from _file_probes("sweep", work, sorted((SCENARIOS / "sweeps").glob("*.yaml")), lambda p: load_sweep(p, spec))
 
 
 def spec_probes(work: Path, limit: int | None, rng: random.Random) -> Iterator[Probe]:
