@@ -193,3 +193,13 @@ uint8_t fw_every(uint16_t *next, uint16_t now, uint16_t period)
     *next = (uint16_t)(now + period);
     return 1;
 }
+
+void fw_last3_add(fw_last3 *l, int16_t v)
+{
+    l->v[l->next] = v;
+    l->next = (uint8_t)((l->next + 1u) % 3u);
+    if (l->n < 3u)
+        l->n++;
+}
+
+int16_t fw_last3_mean(const fw_last3 *l) { return fw_mean(l->v, l->n); }

@@ -58,6 +58,14 @@ void fw_slave_poll(fw_slave *s, uint16_t now);
 uint8_t fw_check_alarms(fw_alarm *alarms, const int16_t *values, uint8_t channels, int16_t rearm, fw_slave *s,
                         uint16_t now);
 
+/* The last three readings (seed 3.2.16, 3.2.17: the value sent is their mean). */
+typedef struct {
+    int16_t v[3];
+    uint8_t n, next;
+} fw_last3;
+void fw_last3_add(fw_last3 *l, int16_t v);
+int16_t fw_last3_mean(const fw_last3 *l);   /* n > 0 */
+
 /* A periodic measurement on the node's own clock (Runtime.every: now, then every period). */
 uint8_t fw_every(uint16_t *next, uint16_t now, uint16_t period);
 
