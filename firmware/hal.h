@@ -18,8 +18,9 @@
  * FW_IDLE_GAP_US after the last byte (timer interrupt). Defined in main.c. */
 void fw_rx_byte(uint8_t byte);
 void fw_rx_gap(void);
-/* Counters of main.c a debugger or a behaviour can read (fw_rx_errors: corrupt frames heard). */
-extern volatile uint16_t fw_rx_frames, fw_rx_errors, fw_rx_overruns;
+/* Counters of main.c a debugger or a behaviour can read: frames for us, frames refused (any
+ * reason, also frames for other nodes), overruns, and corrupt frames heard (collisions). */
+extern volatile uint16_t fw_rx_frames, fw_rx_errors, fw_rx_overruns, fw_rx_corrupt;
 
 void hal_init(void);
 void hal_enable_interrupts(void);

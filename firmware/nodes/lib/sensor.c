@@ -92,13 +92,13 @@ uint8_t fw_three_plus_three(fw_read_fn read, void *ctx, uint8_t channels, int16_
     return 0;
 }
 
-/* fw_rx_errors is written by the RX interrupt: read until two reads agree (no torn 16-bit value) */
+/* fw_rx_corrupt is written by the RX interrupt: read until two reads agree (no torn 16-bit value) */
 static uint16_t rx_errors(void)
 {
     uint16_t e;
     do {
-        e = fw_rx_errors;
-    } while (e != fw_rx_errors);
+        e = fw_rx_corrupt;
+    } while (e != fw_rx_corrupt);
     return e;
 }
 
