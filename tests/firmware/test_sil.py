@@ -126,3 +126,115 @@ def test_high_obstacle_with_the_tpsc_in_simavr_behaves_like_the_python_run(firmw
     assert any(s.startswith("ID_ACK") for s in sent), sent
     assert any(s.startswith("XMIT_DATA_TPSC") for s in sent), sent
     assert sm["max_reaction_s"] is not None and sm["max_reaction_s"] <= 1.0
+
+
+# ---- issue 15 part 3: the seven sensor controllers in C, the whole sensor bus as firmware ----------
+
+SENSOR_BUS = ("USRC", "TPSC", "IRRC", "ISC", "TSC", "LSC", "PSC")
+
+
+def test_sil_names_take_comma_lists_and_repeats_and_keep_a_node_name_s_comma():
+    from firmware.sil_bridge import sil_names
+    assert sil_names(["USRC,TPSC", "IRRC", "TPSC"]) == ["USRC", "TPSC", "IRRC"]
+    assert sil_names(["JAC(1,1),TPSC"]) == ["JAC(1,1)", "TPSC"]
+
+
+def test_sil_refuses_an_unknown_node_and_an_empty_list_in_one_line(spec):
+    from arachnae.errors import UserError
+    from firmware.sil_bridge import check_sil_nodes, sil_names
+    with pytest.raises(UserError, match="--sil USRCX: no such node"):
+        check_sil_nodes(spec, sil_names(["USRC,USRCX"]))
+    with pytest.raises(UserError, match="no node given"):
+        check_sil_nodes(spec, sil_names([","]))
+    with pytest.raises(UserError, match="role MMC has no firmware"):
+        check_sil_nodes(spec, ["MMC"])
+
+
+def answer_port(host, until: int, reply) -> list:
+    """Run like the bridge and answer every sensor-port request with reply(code, arg) (None: no reply)."""
+    events = []
+    while host.cycle < until:
+        for e in host.run(until):
+            events.append(e)
+            if e[0] == "a":
+                values = reply(e[2], e[3])
+                if values is not None:
+                    host.reply(values)
+            elif e[0] == "p" and e[2] == "D2" and e[3] == 1:
+                host.set_pin("C2", 0)
+    return events
+
+
+def test_irrc_firmware_three_plus_three_rule_declares_itself_unreliable(host_factory):
+    """seed 3.2.13: readings spread too far twice -> UNRELIABLE; the last reliable value stays (CHOICE)."""
+    from arachnae_proto import frame, messages
+    from firmware.sil_bridge import hal_enum
+    ir, status_note = hal_enum("HAL_SAMPLE_")["IR"], hal_enum("HAL_NOTE_")["STATUS"]
+    h = host_factory("avr/irrc.elf")
+    h.set_pin("C2", 0)
+    reads = []
+
+    def steady(code, arg):
+        if code == ir:
+            reads.append(code)
+            return [100, 101, 100]
+        return None
+    ev = answer_port(h, 200 * MS, steady)
+    # measures on its own clock (tuning.IRRC_MEASURE_S = 50 ms): 3 readings each, none spread
+    assert 9 <= len(reads) <= 15, len(reads)
+    assert not any(e[0] == "a" and e[2] == status_note for e in ev)
+    toggle = [0]
+
+    def spread(code, arg):
+        if code == ir:
+            toggle[0] ^= 1
+            return [100 + 60 * toggle[0]] * 3        # 60 raw steps apart > IRRC_SPREAD_RAW 40
+        return None
+    ev = answer_port(h, h.cycle + 100 * MS, spread)
+    notes = [e for e in ev if e[0] == "a" and e[2] == status_note]
+    assert [e[3] for e in notes] == [2]               # UNRELIABLE, once
+    send(h, frame.build(0x29, 0x04, messages.StatusReq()))
+    out = tx_bytes(answer_port(h, h.cycle + 120 * MS, spread))
+    # the DATA_RDY announcing the change may come first; the reply to STATUS_REQ is the last frame
+    assert frame.parse(out[-7:]).message == messages.StatusAckRange(status=2)
+    send(h, frame.build(0x29, 0x04, messages.XmitData()))
+    out = tx_bytes(answer_port(h, h.cycle + 120 * MS, spread))
+    assert frame.parse(out[-9:]).message == messages.XmitDataIrrc(left=100, center=101, right=100)
+
+
+def test_lsc_firmware_sends_the_mean_of_the_last_three_readings(host_factory):
+    """seed 3.2.16: the value sent is the mean of the last three (half to even, as Python's round)."""
+    from arachnae_proto import frame, messages
+    from firmware.sil_bridge import hal_enum
+    light = hal_enum("HAL_SAMPLE_")["LIGHT"]
+    h = host_factory("avr/lsc.elf")
+    h.set_pin("C2", 0)
+    seq = iter([10, 20, 40, 70, 90] + [90] * 100)
+
+    def reply(code, arg):
+        return [next(seq)] if code == light else None
+    answer_port(h, 850 * MS, reply)                    # readings at 0, 200, 400, 600, 800 ms
+    send(h, frame.build(0x2C, 0x04, messages.XmitData()))
+    out = tx_bytes(answer_port(h, h.cycle + 100 * MS, reply))
+    assert frame.parse(out).message == messages.XmitDataLsc(brightness=round((40 + 70 + 90) / 3))
+
+
+@pytest.mark.parametrize("scenario", ["fault_ir_unreliable", "fault_us_failed", "fault_battery"])
+def test_fault_scenario_with_the_whole_sensor_bus_in_simavr_passes_like_python(firmware_built, spec, scenario):
+    """issue 15: the seven sensor controllers as AVR firmware; same expectations and POST verdict as Python."""
+    from firmware.sil_bridge import run_scenario
+    from sim2d import runner
+    path = str(REPO / "scenarios" / f"{scenario}.yaml")
+    python = runner.run(path, spec=spec)
+    made: list = []
+    sil = run_scenario(path, (",".join(SENSOR_BUS),), spec=spec, made=made)
+    assert not python.failed, python.failed
+    assert not sil.failed, sil.failed
+    assert sil.result.metrics["post"]["verdict"] == python.result.metrics["post"]["verdict"]
+    # every sensor was firmware and took part: it answered the SPU's POST and was fetched from
+    assert sorted(n.node.short for n in made) == sorted(SENSOR_BUS)
+    senders = {f.sender for f in sil.result.frames}
+    assert set(SENSOR_BUS) <= senders
+    for n in made:
+        if n.host.proc.poll() is None:
+            assert 0 < n.host.stack_used() < 512
