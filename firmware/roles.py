@@ -121,7 +121,11 @@ def slave_timing(spec, node, bus, rank: int, requesters: int, slot_us: float) ->
         quiet_us = bus.turnaround_us + (0.0 if not net.reflexes or is_reflex
                                         else gap_us - bus.turnaround_us + net.reflex_lead_bits * bit_us)
     scope_all = net.arbitration.get(bus.name) == "address_backoff" and net.backoff_scope == "all"
-    return [
+    reflex = net.reflex_from(node.address)
+    interval = [] if reflex is None else [
+        "/* spec reflexes (seed 5.2): this node raises a reflex request at most this often */",
+        f"#define FW_REFLEX_MIN_INTERVAL_MS {math.ceil(reflex.min_interval_s * 1000)}u"]
+    return interval + [
         "/* seed 3.2.2 'when the bus is idle': the line quiet this long before a DATA_RDY (behaviours/runtime.py) */",
         f"#define FW_SLAVE_QUIET_US {math.ceil(quiet_us)}UL",
         "/* spec address_backoff, scope all: after any corrupt frame, wait for our slot of the window */",

@@ -81,7 +81,8 @@ def test_tpsc_firmware_answers_id_req_and_status_req_like_the_python_codec(host_
 
 
 def test_tpsc_initiates_and_resends_after_a_corrupt_echo(host_factory, spec):
-    """seed 3.2.12: the TPSC always initiates; seed 3.2.2 + address_backoff: resend after (rank+1) slots."""
+    """seed 3.2.12: the TPSC always initiates; seed 3.2.2 + address_backoff (scope all): after the corrupt echo
+    it resends in its slot of the window (rank 0: the first) once the line was quiet for the response timeout."""
     from arachnae_proto import frame, messages
     h = host_factory("avr/tpsc.elf")
     for pin in ("C0", "C1"):
@@ -103,7 +104,8 @@ def test_tpsc_initiates_and_resends_after_a_corrupt_echo(host_factory, spec):
     slot = bus.frame_time_us(spec.frame.overhead) + bus.turnaround_us
     rank = [n.address for n in spec.requesters("sensor")].index(0x28)     # spec rank_order
     gap_ms = (again[0][1] - first) / MS
-    assert (rank + 1) * slot / 1000 < gap_ms < (rank + 1) * slot / 1000 + 60   # backoff after the frame
+    quiet = bus.response_timeout_ms                                        # AfterReplies, reflex source
+    assert rank == 0 and slot / 1000 + quiet < gap_ms < slot / 1000 + quiet + 60   # the frame, then the quiet time
     send(h, frame.build(0x28, 0x04, messages.XmitData()))
     out = tx_bytes(run_like_the_bridge(h, h.cycle + 80 * MS))
     assert frame.parse(out).message == messages.XmitDataTpsc(contact=0x20)   # OBJ_RIGHT
