@@ -20,12 +20,6 @@ typedef struct {
 
 static irrc_state st;
 
-static void read_beams(int16_t *values, void *ctx)
-{
-    (void)ctx;
-    hal_sample(HAL_SAMPLE_IR, 0, values, BEAMS);
-}
-
 static void declare(uint8_t status, uint16_t now)
 {
     if (status == st.status)
@@ -40,10 +34,10 @@ static void declare(uint8_t status, uint16_t now)
 static void measure(uint16_t now)
 {
     int16_t got[BEAMS];
-    uint8_t near, b;
+    uint8_t near, b, ok;
     int16_t nearest;
     fw_debug[FW_DBG_MEASUREMENTS]++;
-    uint8_t ok = fw_three_plus_three(read_beams, 0, BEAMS, TUNING_IRRC_SPREAD_RAW, got, &st.second_sets);
+    ok = fw_three_plus_three(HAL_SAMPLE_IR, 0, BEAMS, 0, TUNING_IRRC_SPREAD_RAW, got, &st.second_sets, 0);
     fw_debug[FW_DBG_SECOND_SETS] = (int16_t)st.second_sets;
     if (!ok) {
         declare(ARACHNAE_RANGE_STATUS_UNRELIABLE, now);

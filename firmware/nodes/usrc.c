@@ -27,15 +27,6 @@ typedef struct {
 
 static usrc_state st;
 
-static void ping(int16_t *value, void *ctx)
-{
-    int16_t reply[2];
-    (void)ctx;
-    hal_sample(HAL_SAMPLE_SONAR, st.head, reply, 2);    /* distance, echo time (us) */
-    *value = reply[0];
-    st.tof_us += (uint16_t)reply[1];
-}
-
 static void declare(uint8_t status, uint16_t now)
 {
     if (status == st.status)
@@ -53,7 +44,9 @@ static void measure(uint16_t now)
     uint8_t ok;
     st.tof_us = 0;
     fw_debug[FW_DBG_MEASUREMENTS]++;
-    ok = fw_three_plus_three(ping, 0, 1, TUNING_USRC_SPREAD_RAW, &got, &st.second_sets);
+    /* each ping: the distance and its echo time (us), at the head's angle */
+    ok = fw_three_plus_three(HAL_SAMPLE_SONAR, st.head, 1, 1, TUNING_USRC_SPREAD_RAW, &got, &st.second_sets,
+                             &st.tof_us);
     fw_debug[FW_DBG_SECOND_SETS] = (int16_t)st.second_sets;
     if (!ok) {
         declare(ARACHNAE_RANGE_STATUS_UNRELIABLE, now);

@@ -62,15 +62,20 @@ int16_t fw_mean(const int16_t *v, uint8_t n)
 
 #define MAX_CHANNELS 3u
 
-uint8_t fw_three_plus_three(fw_read_fn read, void *ctx, uint8_t channels, int16_t spread, int16_t *out,
-                            uint16_t *second_sets)
+uint8_t fw_three_plus_three(uint8_t kind, uint16_t arg, uint8_t channels, uint8_t timed, int16_t spread,
+                            int16_t *out, uint16_t *second_sets, uint32_t *time_us)
 {
-    int16_t sets[3][MAX_CHANNELS];
+    int16_t sets[3][MAX_CHANNELS + 1u];
     uint8_t attempt, i, c;
+    if (channels > MAX_CHANNELS)
+        return 0;
     for (attempt = 0; attempt < 2; attempt++) {
         uint8_t ok = 1;
-        for (i = 0; i < 3; i++)
-            read(sets[i], ctx);
+        for (i = 0; i < 3; i++) {
+            hal_sample(kind, arg, sets[i], (uint8_t)(channels + (timed ? 1u : 0u)));
+            if (timed)
+                *time_us += (uint16_t)sets[i][channels];
+        }
         for (c = 0; c < channels; c++) {
             int16_t lo = sets[0][c], hi = sets[0][c], col[3];
             for (i = 0; i < 3; i++) {

@@ -30,10 +30,11 @@ int16_t fw_mean(const int16_t *v, uint8_t n);
 
 /* seed 3.2.11/3.2.13: three readings averaged per channel; if one channel spreads further
  * than `spread`, three more; if those spread too: 0 (UNRELIABLE), else 1 and out[] the means.
- * `read` fills `channels` values; *second_sets counts the second sets taken. */
-typedef void (*fw_read_fn)(int16_t *values, void *ctx);
-uint8_t fw_three_plus_three(fw_read_fn read, void *ctx, uint8_t channels, int16_t spread, int16_t *out,
-                            uint16_t *second_sets);
+ * A reading is hal_sample(kind, arg): `channels` values, then, if `timed`, the conversion's
+ * time in microseconds, added to *time_us (the sonar's echo times). *second_sets counts the
+ * second sets taken. (No function pointer: the static stack figure stays exact.) */
+uint8_t fw_three_plus_three(uint8_t kind, uint16_t arg, uint8_t channels, uint8_t timed, int16_t spread,
+                            int16_t *out, uint16_t *second_sets, uint32_t *time_us);
 
 /* A slave's DATA_RDY to its master (behaviours.sensors._Sensor.announce / fetched, runtime slave_send). */
 typedef struct {
