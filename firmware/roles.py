@@ -80,7 +80,7 @@ def role_config(spec, role: str) -> str:
                   "#define FW_MASTER_ADDRESS 0x00u", "#define FW_BACKOFF_RANK 0u", "#define FW_BACKOFF_SLOT_US 0UL",
                   "#define FW_SLAVE_QUIET_US 0UL", "#define FW_BACKOFF_SCOPE_ALL 0u", "#define FW_BACKOFF_STEP_US 0UL",
                   "#define FW_REQUESTERS 0u"]
-    lines += tuning(role)
+    lines += tuning(role) + alarm_limit(role)
     tx_max = spec.frame.overhead + max((m.max_size for m in spec.sends(role)), default=0)
     char_us = spec.buses[node.bus].char_time_us if node.bus else 1e6 * 10 / 9600
     low = role.lower()
@@ -133,6 +133,29 @@ def slave_timing(spec, node, bus, rank: int, requesters: int, slot_us: float) ->
         f"#define FW_BACKOFF_STEP_US {round(net.backoff_slots * slot_us)}UL",
         f"#define FW_REQUESTERS {requesters}u",
     ]
+
+
+# a sensor's SET_ALARM limit and the data field it is compared with (behaviours/sensors.py)
+ALARM_FIELDS = {"IRRC": ("SetAlarmIrrc", "XmitDataIrrc", "center"), "ISC": ("SetAlarmIsc", "XmitDataIsc", "longitudinal"),
+                "TSC": ("SetAlarmTsc", "XmitDataTsc", "temperature"), "LSC": ("SetAlarmLsc", "XmitDataLsc", "brightness"),
+                "PSC": ("SetAlarmPsc", "XmitDataPsc", "voltage")}
+
+
+def alarm_limit(role: str) -> list[str]:
+    """Whether the SET_ALARM limit's raw value IS the data field's raw value (behaviours.sensors.limit_in is the
+    identity over the limit's whole raw range): then the firmware compares it as it comes, without linking the
+    physical conversions (LSC: a log table); else it converts through the generated _to_milli/_from_milli."""
+    if role not in ALARM_FIELDS:
+        return []
+    from arachnae_proto import messages as M
+    from behaviours.sensors import limit_in
+    from behaviours.units import quantizer
+    alarm, data, field = ALARM_FIELDS[role]
+    info = next(f for f in getattr(M, alarm).FIELDS if f.name == "limit")
+    lo, hi = info.conv.lo, info.conv.hi
+    same = all(limit_in(quantizer(getattr(M, data), field), getattr(M, alarm), r) == r for r in range(lo, hi + 1))
+    return [f"/* SET_ALARM limit raw {lo}..{hi} equals the {field} raw value for every value (checked by roles.py) */",
+            f"#define FW_ALARM_LIMIT_IS_DATA_RAW {1 if same else 0}"]
 
 
 def tuning(role: str) -> list[str]:

@@ -105,9 +105,13 @@ void irrc_on_set_alarm_irrc(irrc_node *node, const arachnae_header *h, const ara
     uint8_t raw = 0, b;
     (void)node;
     (void)h;
+#if FW_ALARM_LIMIT_IS_DATA_RAW
+    raw = msg->limit;                        /* one encoding for both (spec; checked by roles.py) */
+#else
     if (arachnae_xmit_data_irrc_center_from_milli(arachnae_set_alarm_irrc_limit_to_milli(msg->limit), &raw)
         != ARACHNAE_OK)
         raw = UINT8_MAX;                     /* beyond the measuring range: saturates as the front end does */
+#endif
     for (b = 0; b < BEAMS; b++)
         fw_alarm_set(&st.alarms[b], (int16_t)raw, FW_BELOW);
 }

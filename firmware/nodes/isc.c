@@ -7,6 +7,10 @@
 #include "hal.h"
 #include "lib/sensor.h"
 
+#if !FW_ALARM_LIMIT_IS_DATA_RAW
+#error "the SET_ALARM limit and the data differ in encoding: convert as irrc.c does"
+#endif
+
 enum { AXES = 2 };
 
 typedef struct {

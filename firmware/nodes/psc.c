@@ -79,9 +79,13 @@ void psc_on_set_alarm_psc(psc_node *node, const arachnae_header *h, const arachn
     uint8_t raw = 0;
     (void)node;
     (void)h;
+#if FW_ALARM_LIMIT_IS_DATA_RAW
+    raw = msg->limit;                        /* one encoding for both (spec; checked by roles.py) */
+#else
     if (arachnae_xmit_data_psc_voltage_from_milli(arachnae_set_alarm_psc_limit_to_milli(msg->limit), &raw)
         != ARACHNAE_OK)
         raw = 0;                             /* below the measuring range: never crossed */
+#endif
     fw_alarm_set(&st.alarm, (int16_t)raw, FW_BELOW);
 }
 

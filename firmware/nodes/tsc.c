@@ -8,6 +8,10 @@
 #include "hal.h"
 #include "lib/sensor.h"
 
+#if !FW_ALARM_LIMIT_IS_DATA_RAW
+#error "the SET_ALARM limit and the data differ in encoding: convert as irrc.c does"
+#endif
+
 #define PROBES_MAX 8u   /* seed 3.2.15: up to eight probes (XMIT_DATA_TSC channel 0..7) */
 
 typedef struct {
