@@ -242,3 +242,36 @@ def test_fault_scenario_with_the_whole_sensor_bus_in_simavr_passes_like_python(f
     for n in made:
         if n.host.proc.poll() is None:
             assert 0 < n.host.stack_used() < 512
+
+
+def test_irrc_firmware_alarm_fires_once_per_crossing_and_rearms_with_hysteresis(host_factory):
+    """seed 3.2.13 SET_ALARM: closer than the limit -> one alarm and a DATA_RDY to the SPU; it fires again only
+    after the value was back ALARM_REARM_RAW steps beyond the limit (behaviours.sensors.AlarmLimit)."""
+    from arachnae_proto import frame, messages
+    from behaviours import tuning as T
+    from firmware.sil_bridge import hal_enum
+    ir, alarm = hal_enum("HAL_SAMPLE_")["IR"], hal_enum("HAL_NOTE_")["ALARM"]
+    limit = messages.SetAlarmIrrc.from_phys(limit=T.SPU_ALARM_IRRC_CM).limit   # same encoding as the data
+    rearm = T.ALARM_REARM_RAW["IRRC"]
+    h = host_factory("avr/irrc.elf")
+    h.set_pin("C2", 0)
+    level = [limit + 50]
+
+    def reply(code, arg):
+        return [255, level[0], 255] if code == ir else None
+    answer_port(h, 60 * MS, reply)
+    send(h, frame.build(0x29, 0x04, messages.SetAlarmIrrc(limit=limit)))
+    answer_port(h, h.cycle + 100 * MS, reply)
+
+    def phase(value, ms=300):
+        level[0] = value
+        ev = answer_port(h, h.cycle + ms * MS, reply)
+        return [e[3] for e in ev if e[0] == "a" and e[2] == alarm], tx_bytes(ev)
+    fired, out = phase(limit - 1)
+    assert fired == [0b010]                                  # the centre beam, once
+    assert frame.build(0x04, 0x29, messages.DataRdy()) in out  # announced on its own
+    assert phase(limit - 20)[0] == []                        # still beyond: no second alarm
+    assert phase(limit + rearm - 1)[0] == []                 # back, but not far enough to re-arm
+    assert phase(limit - 1)[0] == []
+    assert phase(limit + rearm)[0] == []                     # re-armed ...
+    assert phase(limit - 1)[0] == [0b010]                    # ... so the next crossing fires again
