@@ -139,9 +139,11 @@ def cmd_run(args: argparse.Namespace) -> int:
     _check_file(args.scenario)
     replace_nodes = None
     sil_made: list[Any] = []
+    sil_errors: tuple[type[Exception], ...] = ()
     if args.sil:
-        from firmware.sil_bridge import check_sil_nodes, sil_factory, sil_names
+        from firmware.sil_bridge import SilError, check_sil_nodes, sil_factory, sil_names
 
+        sil_errors = (SilError,)
         names = sil_names(args.sil)
         check_sil_nodes(runner.load_spec_once(), names)
         replace_nodes = {name: sil_factory(made=sil_made) for name in names}
@@ -151,6 +153,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     try:
         outcome = runner.run(args.scenario, args.seed, gif=args.gif, replace_nodes=replace_nodes,
                              console=console, pace=args.pace)
+    except sil_errors as exc:
+        raise UserError(f"--sil: the firmware run failed: {exc}") from None   # e.g. the AVR crashed in simavr
     finally:
         if console is not None:
             console.close()             # restores a raw terminal before anything is printed
