@@ -18,7 +18,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from firmware.sil_bridge import ram_lines, ram_use, run_scenario, sil_names  # noqa: E402
+from firmware.sil_bridge import ram_lines, ram_use, sil_names  # noqa: E402
 from sim2d import runner  # noqa: E402
 
 SENSOR_BUS = "USRC,TPSC,IRRC,ISC,TSC,LSC,PSC"
@@ -34,7 +34,7 @@ def cpu_s() -> float:
 def timed(path: str, spec, sil: tuple[str, ...] = ()):
     made: list = []
     t0, c0 = time.perf_counter(), cpu_s()
-    out = run_scenario(path, sil, spec=spec, made=made) if sil else runner.run(path, spec=spec)
+    out = runner.run_sil(path, sil, spec=spec, made=made) if sil else runner.run(path, spec=spec)
     ram = ram_use([n for n in made if n.host.proc.poll() is None])
     for n in made:
         n.host.close()                      # waits for the host: its CPU time is counted

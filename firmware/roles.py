@@ -24,7 +24,7 @@ GEN_C = REPO / "generated" / "c"
 
 
 def _spec():
-    from codegen.model import load_spec
+    from codegen.load import load_spec
     return load_spec()
 
 

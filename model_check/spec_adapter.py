@@ -21,7 +21,7 @@ MISSING_FIELDS = [
 
 def load(spec_dir: str | None = None):
     try:
-        from codegen.model import load_spec
+        from codegen.load import load_spec
     except ImportError as exc:  # pragma: no cover - the lead's loader is part of the repo
         raise UserError(f"cannot load the spec model: {exc}") from None
     return load_spec(spec_dir)

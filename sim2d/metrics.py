@@ -1,6 +1,7 @@
 """Metrics of a finished run and the scenario's expectations checked against them."""
 from __future__ import annotations
 
+import hashlib
 import math
 from bisect import bisect_left
 from typing import TYPE_CHECKING, Any, Sequence
@@ -10,7 +11,7 @@ from sim2d.nav_metrics import nav_schema
 
 if TYPE_CHECKING:
     from sim2d.robot import Robot
-    from sim2d.sim import Simulation
+    from sim2d.sim import Simulation, TraceEntry
 
 
 def reactions(stimuli: list[tuple[float, str]], moves: list[tuple[float, int]],
@@ -163,11 +164,21 @@ def metric_node(schema: dict[str, Any], path: str) -> dict[str, Any] | str | Non
     return node
 
 
+def trace_hash(frames: list[TraceEntry], poses: list[tuple[float, float, float, float]]) -> str:
+    """SHA-256 over every frame (times, bus, sender, bytes sent and heard, flags) and the pose log."""
+    h = hashlib.sha256()
+    for f in frames:
+        h.update(f"{f.start:.9f} {f.end:.9f} {f.bus} {f.sender} {f.sent.hex()} "
+                 f"{f.heard.hex() if f.heard is not None else '-'} {','.join(f.flags)}\n".encode())
+    for t, x, y, th in poses:
+        h.update(f"{t:.3f} {x:.9f} {y:.9f} {th:.9f}\n".encode())
+    return h.hexdigest()
+
+
 def build_metrics(sim: "Simulation") -> dict[str, Any]:
     from sim2d.level0_io import rcp_metrics, sound_metrics
     from sim2d.nav_metrics import nav_metrics
     from sim2d.gait_metrics import motion_metrics
-    from sim2d.sim import trace_hash
     dur = sim.scenario.duration
     buses = {}
     for name, b in sim.buses.items():

@@ -40,7 +40,7 @@ class Outcome:
 
 
 def load_spec_once() -> Any:
-    from codegen.model import load_spec
+    from codegen.load import load_spec
     return load_spec()
 
 
@@ -57,6 +57,17 @@ def run(path: str, seed: int | None = None, spec: Any = None, gif: bool = False,
         attach_console(sim, console if console is not None else WallClock(), 1.0 if pace is None else pace)
     result = sim.run()
     return Outcome(sc, result, check_expectations(sc, result.metrics), bytes(sim.rcp.screen), spec)
+
+
+def run_sil(path: str, sil: tuple[str, ...], seed: int | None = None, spec: Any = None,
+            made: list[Any] | None = None) -> Outcome:
+    """`run` with the nodes in `sil` (names or comma lists) run as AVR firmware in simavr, as `arachnae sim run
+    --sil` does; the SilNodes made are appended to `made` (their RAM use can be read until they are closed)."""
+    from firmware.sil_bridge import check_sil_nodes, sil_factory, sil_names
+    spec = spec or load_spec_once()
+    names = sil_names(list(sil))
+    check_sil_nodes(spec, names)
+    return run(path, seed, spec=spec, replace_nodes={name: sil_factory(made=made) for name in names})
 
 
 def _protected(target: Path) -> str | None:

@@ -25,7 +25,7 @@ import yaml
 from arachnae.errors import UserError, located
 from arachnae.validation import Validator, check_schema, field_name, fill_defaults
 from arachnae.yamlio import LDict, LList, load_yaml, locate, new_dict, new_list
-from console.keymap import KEYMAP
+from behaviours.rcp_keys import KEYMAP
 from sim2d.geometry import (WALL_RADIUS, on_one_line, point_in_polygon, polygons_overlap, seg_seg_distance,
                             self_crossing, signed_area, to_world)
 from sim2d.metrics import metric_node, metrics_schema

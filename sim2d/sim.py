@@ -11,7 +11,6 @@ is stepped per bit or per byte.
 """
 from __future__ import annotations
 
-import hashlib
 import math
 from dataclasses import dataclass, field, replace
 from typing import Any, Callable
@@ -329,14 +328,3 @@ def capture_frames(frames: list[TraceEntry]) -> list[CapturedFrame]:
            for f in frames]
     out.sort(key=lambda c: c.time_ns)
     return out
-
-
-def trace_hash(frames: list[TraceEntry], poses: list[tuple[float, float, float, float]]) -> str:
-    """SHA-256 over every frame (times, bus, sender, bytes sent and heard, flags) and the pose log."""
-    h = hashlib.sha256()
-    for f in frames:
-        h.update(f"{f.start:.9f} {f.end:.9f} {f.bus} {f.sender} {f.sent.hex()} "
-                 f"{f.heard.hex() if f.heard is not None else '-'} {','.join(f.flags)}\n".encode())
-    for t, x, y, th in poses:
-        h.update(f"{t:.3f} {x:.9f} {y:.9f} {th:.9f}\n".encode())
-    return h.hexdigest()

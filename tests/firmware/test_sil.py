@@ -115,12 +115,12 @@ def test_tpsc_initiates_and_resends_after_a_corrupt_echo(host_factory, spec):
 
 
 def test_high_obstacle_with_the_tpsc_in_simavr_behaves_like_the_python_run(firmware_built, spec):
-    from firmware.sil_bridge import run_scenario
+    from sim2d.runner import run_sil
     from sim2d import runner
     from sim2d.sim import trace_lines
     path = str(REPO / "scenarios" / "high_obstacle.yaml")
     python = runner.run(path, spec=spec)
-    sil = run_scenario(path, ("TPSC",), spec=spec)
+    sil = run_sil(path, ("TPSC",), spec=spec)
     assert not python.failed, python.failed
     assert not sil.failed, sil.failed
     pm, sm = python.result.metrics, sil.result.metrics
@@ -226,12 +226,12 @@ def test_lsc_firmware_sends_the_mean_of_the_last_three_readings(host_factory):
 @pytest.mark.parametrize("scenario", ["fault_ir_unreliable", "fault_us_failed", "fault_battery"])
 def test_fault_scenario_with_the_whole_sensor_bus_in_simavr_passes_like_python(firmware_built, spec, scenario):
     """issue 15: the seven sensor controllers as AVR firmware; same expectations and POST verdict as Python."""
-    from firmware.sil_bridge import run_scenario
+    from sim2d.runner import run_sil
     from sim2d import runner
     path = str(REPO / "scenarios" / f"{scenario}.yaml")
     python = runner.run(path, spec=spec)
     made: list = []
-    sil = run_scenario(path, (",".join(SENSOR_BUS),), spec=spec, made=made)
+    sil = run_sil(path, (",".join(SENSOR_BUS),), spec=spec, made=made)
     assert not python.failed, python.failed
     assert not sil.failed, sil.failed
     assert sil.result.metrics["post"]["verdict"] == python.result.metrics["post"]["verdict"]

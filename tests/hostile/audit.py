@@ -210,7 +210,7 @@ def sweep_probes(work: Path, spec: Any) -> Iterator[Probe]:
 
 def spec_probes(work: Path, limit: int | None, rng: random.Random) -> Iterator[Probe]:
     """Mutations of the spec's files, checked as `arachnae spec check` checks them (a sample when limited)."""
-    from codegen.model import load_spec
+    from codegen.load import load_spec
     spec_root = REPO / "spec"
     files = sorted(spec_root.glob("*.yaml"))
     for target in files:
@@ -256,7 +256,7 @@ def frame_probes(rng: random.Random, count: int) -> Iterator[Probe]:
 
 def console_probes(rng: random.Random, count: int) -> Iterator[Probe]:
     """Random bytes into the console's key decoder: keys are ASCII, nothing raises."""
-    from console.keymap import KeyDecoder
+    from behaviours.rcp_keys import KeyDecoder
 
     def run(data: bytes) -> None:
         keys = KeyDecoder().feed(data)
@@ -295,7 +295,7 @@ def cli_probes(work: Path) -> Iterator[Probe]:
 
 
 def all_probes(work: Path, full: bool = False) -> Iterator[Probe]:
-    from codegen.model import load_spec
+    from codegen.load import load_spec
     spec = load_spec(None)
     rng = random.Random(10)
     files = sorted(p.name for p in SCENARIOS.glob("*.yaml")) if full else \
