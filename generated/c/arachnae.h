@@ -447,6 +447,11 @@ void arachnae_frame_header(const uint8_t *frame, arachnae_header *h);
 /* The payload is already at frame + ARACHNAE_FRAME_PAYLOAD: write header and CRC. */
 arachnae_status arachnae_frame_finish(uint8_t *frame, uint16_t cap, uint8_t dst, uint8_t src, uint8_t opcode,
                                       uint8_t payload_len, uint16_t *frame_len);
+/* Writes header and CRC around the payload_len bytes at frame + ARACHNAE_FRAME_PAYLOAD, sets
+ * *frame_len, returns OK; the caller checked that ARACHNAE_FRAME_OVERHEAD + payload_len bytes fit.
+ * (Argument order as the generated _build functions', so that they end in a jump here.) */
+arachnae_status arachnae_frame_seal(uint8_t opcode, uint8_t dst, uint8_t src, uint8_t *frame, uint8_t payload_len,
+                                    uint16_t *frame_len);
 /* Envelope check: TRUNCATED/OVERSIZE, CHECKSUM, then ADDRESS (own = ARACHNAE_ANY_ADDRESS skips it). */
 arachnae_status arachnae_frame_check(const uint8_t *frame, uint16_t len, uint16_t own);
 
@@ -517,6 +522,8 @@ typedef struct {
 
 arachnae_status arachnae_id_ack_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_id_ack_decode(const uint8_t *payload, uint8_t len, arachnae_id_ack_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_id_ack_unpack(const uint8_t *payload, uint8_t len, arachnae_id_ack_t *out);
 arachnae_status arachnae_id_ack_check(const arachnae_id_ack_t *m);
 arachnae_status arachnae_id_ack_encode(const arachnae_id_ack_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_id_ack_build(const arachnae_id_ack_t *m, uint8_t dst, uint8_t src,
@@ -533,6 +540,8 @@ typedef struct {
 
 arachnae_status arachnae_status_ack_busy_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_status_ack_busy_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_busy_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_status_ack_busy_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_busy_t *out);
 arachnae_status arachnae_status_ack_busy_check(const arachnae_status_ack_busy_t *m);
 arachnae_status arachnae_status_ack_busy_encode(const arachnae_status_ack_busy_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_status_ack_busy_build(const arachnae_status_ack_busy_t *m, uint8_t dst, uint8_t src,
@@ -545,6 +554,8 @@ typedef struct {
 
 arachnae_status arachnae_status_ack_order_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_status_ack_order_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_order_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_status_ack_order_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_order_t *out);
 arachnae_status arachnae_status_ack_order_check(const arachnae_status_ack_order_t *m);
 arachnae_status arachnae_status_ack_order_encode(const arachnae_status_ack_order_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_status_ack_order_build(const arachnae_status_ack_order_t *m, uint8_t dst, uint8_t src,
@@ -557,6 +568,8 @@ typedef struct {
 
 arachnae_status arachnae_status_ack_range_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_status_ack_range_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_range_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_status_ack_range_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_range_t *out);
 arachnae_status arachnae_status_ack_range_check(const arachnae_status_ack_range_t *m);
 arachnae_status arachnae_status_ack_range_encode(const arachnae_status_ack_range_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_status_ack_range_build(const arachnae_status_ack_range_t *m, uint8_t dst, uint8_t src,
@@ -572,6 +585,8 @@ typedef struct {
 
 arachnae_status arachnae_status_ack_mmc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_status_ack_mmc_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_mmc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_status_ack_mmc_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_mmc_t *out);
 arachnae_status arachnae_status_ack_mmc_check(const arachnae_status_ack_mmc_t *m);
 arachnae_status arachnae_status_ack_mmc_encode(const arachnae_status_ack_mmc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_status_ack_mmc_build(const arachnae_status_ack_mmc_t *m, uint8_t dst, uint8_t src,
@@ -589,6 +604,8 @@ typedef struct {
 
 arachnae_status arachnae_post_report_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_post_report_decode(const uint8_t *payload, uint8_t len, arachnae_post_report_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_post_report_unpack(const uint8_t *payload, uint8_t len, arachnae_post_report_t *out);
 arachnae_status arachnae_post_report_check(const arachnae_post_report_t *m);
 arachnae_status arachnae_post_report_encode(const arachnae_post_report_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_post_report_build(const arachnae_post_report_t *m, uint8_t dst, uint8_t src,
@@ -617,6 +634,8 @@ typedef struct {
 
 arachnae_status arachnae_xmit_record_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_record_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_record_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_xmit_record_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_record_t *out);
 arachnae_status arachnae_xmit_record_check(const arachnae_xmit_record_t *m);
 arachnae_status arachnae_xmit_record_encode(const arachnae_xmit_record_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_record_build(const arachnae_xmit_record_t *m, uint8_t dst, uint8_t src,
@@ -632,6 +651,8 @@ typedef struct {
 
 arachnae_status arachnae_data_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_data_decode(const uint8_t *payload, uint8_t len, arachnae_data_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_data_unpack(const uint8_t *payload, uint8_t len, arachnae_data_t *out);
 arachnae_status arachnae_data_check(const arachnae_data_t *m);
 arachnae_status arachnae_data_encode(const arachnae_data_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_data_build(const arachnae_data_t *m, uint8_t dst, uint8_t src,
@@ -645,6 +666,8 @@ typedef struct {
 
 arachnae_status arachnae_move_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_move_decode(const uint8_t *payload, uint8_t len, arachnae_move_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_move_unpack(const uint8_t *payload, uint8_t len, arachnae_move_t *out);
 arachnae_status arachnae_move_check(const arachnae_move_t *m);
 arachnae_status arachnae_move_encode(const arachnae_move_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_move_build(const arachnae_move_t *m, uint8_t dst, uint8_t src,
@@ -659,6 +682,8 @@ typedef struct {
 
 arachnae_status arachnae_move_relayed_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_move_relayed_decode(const uint8_t *payload, uint8_t len, arachnae_move_relayed_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_move_relayed_unpack(const uint8_t *payload, uint8_t len, arachnae_move_relayed_t *out);
 arachnae_status arachnae_move_relayed_check(const arachnae_move_relayed_t *m);
 arachnae_status arachnae_move_relayed_encode(const arachnae_move_relayed_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_move_relayed_build(const arachnae_move_relayed_t *m, uint8_t dst, uint8_t src,
@@ -675,6 +700,8 @@ typedef struct {
 
 arachnae_status arachnae_setup_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_setup_decode(const uint8_t *payload, uint8_t len, arachnae_setup_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_setup_unpack(const uint8_t *payload, uint8_t len, arachnae_setup_t *out);
 arachnae_status arachnae_setup_check(const arachnae_setup_t *m);
 arachnae_status arachnae_setup_encode(const arachnae_setup_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_setup_build(const arachnae_setup_t *m, uint8_t dst, uint8_t src,
@@ -689,6 +716,8 @@ typedef struct {
 
 arachnae_status arachnae_speak_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_speak_decode(const uint8_t *payload, uint8_t len, arachnae_speak_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_speak_unpack(const uint8_t *payload, uint8_t len, arachnae_speak_t *out);
 arachnae_status arachnae_speak_check(const arachnae_speak_t *m);
 arachnae_status arachnae_speak_encode(const arachnae_speak_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_speak_build(const arachnae_speak_t *m, uint8_t dst, uint8_t src,
@@ -703,6 +732,8 @@ typedef struct {
 
 arachnae_status arachnae_speak_resident_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_speak_resident_decode(const uint8_t *payload, uint8_t len, arachnae_speak_resident_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_speak_resident_unpack(const uint8_t *payload, uint8_t len, arachnae_speak_resident_t *out);
 arachnae_status arachnae_speak_resident_check(const arachnae_speak_resident_t *m);
 arachnae_status arachnae_speak_resident_encode(const arachnae_speak_resident_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_speak_resident_build(const arachnae_speak_resident_t *m, uint8_t dst, uint8_t src,
@@ -717,6 +748,8 @@ typedef struct {
 
 arachnae_status arachnae_lcd_text_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_lcd_text_decode(const uint8_t *payload, uint8_t len, arachnae_lcd_text_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_lcd_text_unpack(const uint8_t *payload, uint8_t len, arachnae_lcd_text_t *out);
 arachnae_status arachnae_lcd_text_check(const arachnae_lcd_text_t *m);
 arachnae_status arachnae_lcd_text_encode(const arachnae_lcd_text_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_lcd_text_build(const arachnae_lcd_text_t *m, uint8_t dst, uint8_t src,
@@ -729,6 +762,8 @@ typedef struct {
 
 arachnae_status arachnae_uic_alert_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_uic_alert_decode(const uint8_t *payload, uint8_t len, arachnae_uic_alert_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_uic_alert_unpack(const uint8_t *payload, uint8_t len, arachnae_uic_alert_t *out);
 arachnae_status arachnae_uic_alert_check(const arachnae_uic_alert_t *m);
 arachnae_status arachnae_uic_alert_encode(const arachnae_uic_alert_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_uic_alert_build(const arachnae_uic_alert_t *m, uint8_t dst, uint8_t src,
@@ -741,6 +776,8 @@ typedef struct {
 
 arachnae_status arachnae_head_set_abs_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_head_set_abs_decode(const uint8_t *payload, uint8_t len, arachnae_head_set_abs_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_head_set_abs_unpack(const uint8_t *payload, uint8_t len, arachnae_head_set_abs_t *out);
 arachnae_status arachnae_head_set_abs_check(const arachnae_head_set_abs_t *m);
 arachnae_status arachnae_head_set_abs_encode(const arachnae_head_set_abs_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_head_set_abs_build(const arachnae_head_set_abs_t *m, uint8_t dst, uint8_t src,
@@ -753,6 +790,8 @@ typedef struct {
 
 arachnae_status arachnae_head_set_rel_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_head_set_rel_decode(const uint8_t *payload, uint8_t len, arachnae_head_set_rel_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_head_set_rel_unpack(const uint8_t *payload, uint8_t len, arachnae_head_set_rel_t *out);
 arachnae_status arachnae_head_set_rel_check(const arachnae_head_set_rel_t *m);
 arachnae_status arachnae_head_set_rel_encode(const arachnae_head_set_rel_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_head_set_rel_build(const arachnae_head_set_rel_t *m, uint8_t dst, uint8_t src,
@@ -798,6 +837,8 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_usrc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_usrc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_usrc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_xmit_data_usrc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_usrc_t *out);
 arachnae_status arachnae_xmit_data_usrc_check(const arachnae_xmit_data_usrc_t *m);
 arachnae_status arachnae_xmit_data_usrc_encode(const arachnae_xmit_data_usrc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_usrc_build(const arachnae_xmit_data_usrc_t *m, uint8_t dst, uint8_t src,
@@ -813,6 +854,8 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_tpsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_tpsc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_tpsc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_xmit_data_tpsc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_tpsc_t *out);
 arachnae_status arachnae_xmit_data_tpsc_check(const arachnae_xmit_data_tpsc_t *m);
 arachnae_status arachnae_xmit_data_tpsc_encode(const arachnae_xmit_data_tpsc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_tpsc_build(const arachnae_xmit_data_tpsc_t *m, uint8_t dst, uint8_t src,
@@ -827,6 +870,8 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_irrc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_irrc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_irrc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_xmit_data_irrc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_irrc_t *out);
 arachnae_status arachnae_xmit_data_irrc_check(const arachnae_xmit_data_irrc_t *m);
 arachnae_status arachnae_xmit_data_irrc_encode(const arachnae_xmit_data_irrc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_irrc_build(const arachnae_xmit_data_irrc_t *m, uint8_t dst, uint8_t src,
@@ -849,6 +894,8 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_isc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_isc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_isc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_xmit_data_isc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_isc_t *out);
 arachnae_status arachnae_xmit_data_isc_check(const arachnae_xmit_data_isc_t *m);
 arachnae_status arachnae_xmit_data_isc_encode(const arachnae_xmit_data_isc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_isc_build(const arachnae_xmit_data_isc_t *m, uint8_t dst, uint8_t src,
@@ -862,6 +909,8 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_tsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_tsc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_tsc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_xmit_data_tsc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_tsc_t *out);
 arachnae_status arachnae_xmit_data_tsc_check(const arachnae_xmit_data_tsc_t *m);
 arachnae_status arachnae_xmit_data_tsc_encode(const arachnae_xmit_data_tsc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_tsc_build(const arachnae_xmit_data_tsc_t *m, uint8_t dst, uint8_t src,
@@ -874,6 +923,8 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_lsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_lsc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_lsc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_xmit_data_lsc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_lsc_t *out);
 arachnae_status arachnae_xmit_data_lsc_check(const arachnae_xmit_data_lsc_t *m);
 arachnae_status arachnae_xmit_data_lsc_encode(const arachnae_xmit_data_lsc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_lsc_build(const arachnae_xmit_data_lsc_t *m, uint8_t dst, uint8_t src,
@@ -889,6 +940,8 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_psc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_psc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_psc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_xmit_data_psc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_psc_t *out);
 arachnae_status arachnae_xmit_data_psc_check(const arachnae_xmit_data_psc_t *m);
 arachnae_status arachnae_xmit_data_psc_encode(const arachnae_xmit_data_psc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_psc_build(const arachnae_xmit_data_psc_t *m, uint8_t dst, uint8_t src,
@@ -904,6 +957,8 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_irrc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_irrc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_irrc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_set_alarm_irrc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_irrc_t *out);
 arachnae_status arachnae_set_alarm_irrc_check(const arachnae_set_alarm_irrc_t *m);
 arachnae_status arachnae_set_alarm_irrc_encode(const arachnae_set_alarm_irrc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_set_alarm_irrc_build(const arachnae_set_alarm_irrc_t *m, uint8_t dst, uint8_t src,
@@ -920,6 +975,8 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_isc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_isc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_isc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_set_alarm_isc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_isc_t *out);
 arachnae_status arachnae_set_alarm_isc_check(const arachnae_set_alarm_isc_t *m);
 arachnae_status arachnae_set_alarm_isc_encode(const arachnae_set_alarm_isc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_set_alarm_isc_build(const arachnae_set_alarm_isc_t *m, uint8_t dst, uint8_t src,
@@ -933,6 +990,8 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_tsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_tsc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_tsc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_set_alarm_tsc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_tsc_t *out);
 arachnae_status arachnae_set_alarm_tsc_check(const arachnae_set_alarm_tsc_t *m);
 arachnae_status arachnae_set_alarm_tsc_encode(const arachnae_set_alarm_tsc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_set_alarm_tsc_build(const arachnae_set_alarm_tsc_t *m, uint8_t dst, uint8_t src,
@@ -945,6 +1004,8 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_lsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_lsc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_lsc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_set_alarm_lsc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_lsc_t *out);
 arachnae_status arachnae_set_alarm_lsc_check(const arachnae_set_alarm_lsc_t *m);
 arachnae_status arachnae_set_alarm_lsc_encode(const arachnae_set_alarm_lsc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_set_alarm_lsc_build(const arachnae_set_alarm_lsc_t *m, uint8_t dst, uint8_t src,
@@ -960,6 +1021,8 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_psc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_psc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_psc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_set_alarm_psc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_psc_t *out);
 arachnae_status arachnae_set_alarm_psc_check(const arachnae_set_alarm_psc_t *m);
 arachnae_status arachnae_set_alarm_psc_encode(const arachnae_set_alarm_psc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_set_alarm_psc_build(const arachnae_set_alarm_psc_t *m, uint8_t dst, uint8_t src,
@@ -979,6 +1042,8 @@ typedef struct {
 
 arachnae_status arachnae_leg_target_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_leg_target_decode(const uint8_t *payload, uint8_t len, arachnae_leg_target_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_leg_target_unpack(const uint8_t *payload, uint8_t len, arachnae_leg_target_t *out);
 arachnae_status arachnae_leg_target_check(const arachnae_leg_target_t *m);
 arachnae_status arachnae_leg_target_encode(const arachnae_leg_target_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_leg_target_build(const arachnae_leg_target_t *m, uint8_t dst, uint8_t src,
@@ -1008,6 +1073,8 @@ typedef struct {
 
 arachnae_status arachnae_leg_report_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_leg_report_decode(const uint8_t *payload, uint8_t len, arachnae_leg_report_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_leg_report_unpack(const uint8_t *payload, uint8_t len, arachnae_leg_report_t *out);
 arachnae_status arachnae_leg_report_check(const arachnae_leg_report_t *m);
 arachnae_status arachnae_leg_report_encode(const arachnae_leg_report_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_leg_report_build(const arachnae_leg_report_t *m, uint8_t dst, uint8_t src,
@@ -1030,6 +1097,8 @@ typedef struct {
 
 arachnae_status arachnae_joint_target_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_joint_target_decode(const uint8_t *payload, uint8_t len, arachnae_joint_target_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_joint_target_unpack(const uint8_t *payload, uint8_t len, arachnae_joint_target_t *out);
 arachnae_status arachnae_joint_target_check(const arachnae_joint_target_t *m);
 arachnae_status arachnae_joint_target_encode(const arachnae_joint_target_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_joint_target_build(const arachnae_joint_target_t *m, uint8_t dst, uint8_t src,
@@ -1056,6 +1125,8 @@ typedef struct {
 
 arachnae_status arachnae_joint_feedback_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_joint_feedback_decode(const uint8_t *payload, uint8_t len, arachnae_joint_feedback_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_joint_feedback_unpack(const uint8_t *payload, uint8_t len, arachnae_joint_feedback_t *out);
 arachnae_status arachnae_joint_feedback_check(const arachnae_joint_feedback_t *m);
 arachnae_status arachnae_joint_feedback_encode(const arachnae_joint_feedback_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_joint_feedback_build(const arachnae_joint_feedback_t *m, uint8_t dst, uint8_t src,

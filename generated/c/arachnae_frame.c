@@ -44,23 +44,29 @@ void arachnae_frame_header(const uint8_t *frame, arachnae_header *h)
     h->length = frame[ARACHNAE_FRAME_LENGTH];
 }
 
-arachnae_status arachnae_frame_finish(uint8_t *frame, uint16_t cap, uint8_t dst, uint8_t src, uint8_t opcode,
-                                      uint8_t payload_len, uint16_t *frame_len)
+arachnae_status arachnae_frame_seal(uint8_t opcode, uint8_t dst, uint8_t src, uint8_t *frame, uint8_t payload_len,
+                                    uint16_t *frame_len)
 {
-    uint16_t n = (uint16_t)(ARACHNAE_FRAME_OVERHEAD + payload_len);
+    uint16_t n = (uint16_t)(ARACHNAE_FRAME_HEADER_SIZE + payload_len);
     uint16_t crc;
-    if (cap < n)
-        return ARACHNAE_BUFFER;
     frame[ARACHNAE_FRAME_DST] = dst;
     frame[ARACHNAE_FRAME_SRC] = src;
     frame[ARACHNAE_FRAME_OPCODE] = opcode;
     frame[ARACHNAE_FRAME_LENGTH] = payload_len;
-    crc = arachnae_crc16(frame, (uint16_t)(n - ARACHNAE_FRAME_CRC_SIZE));
+    crc = arachnae_crc16(frame, n);
     /* the CRC travels big-endian after the payload (spec frame.byte_order) */
-    frame[n - 2u] = (uint8_t)(crc >> 8);
-    frame[n - 1u] = (uint8_t)(crc & 0xFFu);
-    *frame_len = n;
+    frame[n] = (uint8_t)(crc >> 8);
+    frame[n + 1u] = (uint8_t)(crc & 0xFFu);
+    *frame_len = (uint16_t)(n + ARACHNAE_FRAME_CRC_SIZE);
     return ARACHNAE_OK;
+}
+
+arachnae_status arachnae_frame_finish(uint8_t *frame, uint16_t cap, uint8_t dst, uint8_t src, uint8_t opcode,
+                                      uint8_t payload_len, uint16_t *frame_len)
+{
+    if (cap < (uint16_t)(ARACHNAE_FRAME_OVERHEAD + payload_len))
+        return ARACHNAE_BUFFER;
+    return arachnae_frame_seal(opcode, dst, src, frame, payload_len, frame_len);
 }
 
 arachnae_status arachnae_unhandled_note(arachnae_unhandled *u, uint8_t opcode, arachnae_status st)

@@ -285,6 +285,13 @@ class MessageView:
     def array_wire(self) -> str:
         return " && ".join(self.array.wire_conds(f"payload[{self.fixed_size}u + i]")) if self.array else ""
 
+    @property
+    def size_expr(self) -> str:
+        """C expression: payload bytes of the checked struct `m` (fixed part plus the array's count)."""
+        if self.array is None:
+            return f"{self.fixed_size}u"
+        return f"(uint16_t)({self.fixed_size}u + m->{self.count_field.name})"
+
     def pack_bytes(self, m: str = "m") -> list[tuple[int, str]]:
         """(payload byte index, C expression) for every byte of the fixed part."""
         out = []
@@ -317,6 +324,15 @@ class RoleView:
     @property
     def guard(self) -> str:
         return f"ARACHNAE_NODE_{self.role.upper()}_H"
+
+    @property
+    def empty_receives(self) -> list[MessageView]:
+        """Received messages without fields: one shared `len != 0` check in the payload check."""
+        return [m for m in self.receives if not m.has_fields]
+
+    @property
+    def field_receives(self) -> list[MessageView]:
+        return [m for m in self.receives if m.has_fields]
 
     @property
     def reply_max(self) -> int:
