@@ -443,7 +443,13 @@ uint16_t arachnae_crc16_update(uint16_t crc, uint8_t byte);
 /* CRC over `len` bytes, init and xorout applied. */
 uint16_t arachnae_crc16(const uint8_t *data, uint16_t len);
 /* Reads the header of a frame of at least ARACHNAE_FRAME_HEADER_SIZE bytes. */
-void arachnae_frame_header(const uint8_t *frame, arachnae_header *h);
+static inline void arachnae_frame_header(const uint8_t *frame, arachnae_header *h)
+{
+    h->dst = frame[ARACHNAE_FRAME_DST];
+    h->src = frame[ARACHNAE_FRAME_SRC];
+    h->opcode = frame[ARACHNAE_FRAME_OPCODE];
+    h->length = frame[ARACHNAE_FRAME_LENGTH];
+}
 /* The payload is already at frame + ARACHNAE_FRAME_PAYLOAD: write header and CRC. */
 arachnae_status arachnae_frame_finish(uint8_t *frame, uint16_t cap, uint8_t dst, uint8_t src, uint8_t opcode,
                                       uint8_t payload_len, uint16_t *frame_len);
@@ -464,7 +470,16 @@ typedef struct {
 } arachnae_unhandled;
 
 /* Records `st` for `opcode` when it is not OK; returns st. */
-arachnae_status arachnae_unhandled_note(arachnae_unhandled *u, uint8_t opcode, arachnae_status st);
+static inline arachnae_status arachnae_unhandled_note(arachnae_unhandled *u, uint8_t opcode, arachnae_status st)
+{
+    if (st != ARACHNAE_OK) {
+        if (u->count != 0xFFFFu)
+            u->count++;
+        u->opcode = opcode;
+        u->status = (uint8_t)st;
+    }
+    return st;
+}
 
 /* ---- byte-at-a-time parser (UART RX interrupt) ----
  * feed() returns ARACHNAE_NONE while a frame is incomplete, ARACHNAE_OK when a
@@ -476,17 +491,15 @@ arachnae_status arachnae_unhandled_note(arachnae_unhandled *u, uint8_t opcode, a
  * than its length byte said: feed() then reports OVERSIZE, which supersedes the
  * earlier verdict for that frame. gap() (idle-gap timer) reports TRUNCATED for a
  * frame cut short and re-arms the parser. Call feed() and gap() from contexts
- * that do not preempt each other. The CRC runs one byte per feed(), so an ISR
- * never loops over a whole frame. */
+ * that do not preempt each other. The CRC runs once, over the whole frame, in the
+ * feed() of its last byte: the bus is quiet for the idle gap after it. */
 typedef arachnae_status (*arachnae_payload_check_fn)(uint8_t opcode, const uint8_t *payload, uint8_t len);
 
 typedef struct {
     uint8_t *buf;
     uint16_t cap;
     uint16_t count;
-    uint16_t expected;  /* whole frame size once the length byte arrived, else 0 */
     uint16_t own;
-    uint16_t crc;
     uint8_t state;
     arachnae_payload_check_fn check;  /* OPCODE/LENGTH/RANGE, NULL: envelope only */
 } arachnae_parser;
