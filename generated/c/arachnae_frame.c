@@ -76,8 +76,8 @@ arachnae_status arachnae_frame_check(const uint8_t *frame, uint16_t len, uint16_
         return ARACHNAE_TRUNCATED;
     if (len > need)
         return ARACHNAE_OVERSIZE;
-    len = (uint16_t)(len - ARACHNAE_FRAME_CRC_SIZE);
-    if (arachnae_crc16(frame, len) != (uint16_t)(((unsigned)frame[len] << 8) | (unsigned)frame[len + 1u]))
+    /* MSB-first CRC without xorout: over a good frame with its big-endian CRC it gives 0 */
+    if (arachnae_crc16(frame, len) != 0u)
         return ARACHNAE_CHECKSUM;
     dst = frame[ARACHNAE_FRAME_DST];
     if (own != ARACHNAE_ANY_ADDRESS && dst != own && dst != ARACHNAE_ADDR_BROADCAST)

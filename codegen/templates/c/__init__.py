@@ -358,6 +358,12 @@ class FrameView:
     crc_fast_1021: bool
     crc_check: int
 
+    @property
+    def crc_residue_zero(self) -> bool:
+        """The CRC over header, payload and the big-endian CRC itself is 0 for a good frame
+        (MSB-first CRC, no xorout), so the check needs no second read of the CRC bytes."""
+        return not self.crc_reflected and self.crc_xorout == 0
+
 
 def _frame_view(spec: Spec) -> FrameView:
     fr = spec.frame
