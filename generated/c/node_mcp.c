@@ -45,48 +45,36 @@ arachnae_status mcp_payload_check(uint8_t opcode, const uint8_t *payload, uint8_
 static arachnae_status deliver(mcp_node *node, const arachnae_header *h, const uint8_t *payload)
 {
     switch (h->opcode) {
-    case ARACHNAE_OP_ID_ACK: {
-        arachnae_id_ack_t msg;
-        arachnae_id_ack_unpack(payload, h->length, &msg);
-        mcp_on_id_ack(node, h, &msg);
+    case ARACHNAE_OP_ID_ACK:
+        arachnae_id_ack_unpack(payload, h->length, &node->msg.rx_id_ack);
+        mcp_on_id_ack(node, h, &node->msg.rx_id_ack);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_STATUS_ACK_BUSY: {
-        arachnae_status_ack_busy_t msg;
-        arachnae_status_ack_busy_unpack(payload, h->length, &msg);
-        mcp_on_status_ack_busy(node, h, &msg);
+    case ARACHNAE_OP_STATUS_ACK_BUSY:
+        arachnae_status_ack_busy_unpack(payload, h->length, &node->msg.rx_status_ack_busy);
+        mcp_on_status_ack_busy(node, h, &node->msg.rx_status_ack_busy);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_STATUS_ACK_MMC: {
-        arachnae_status_ack_mmc_t msg;
-        arachnae_status_ack_mmc_unpack(payload, h->length, &msg);
-        mcp_on_status_ack_mmc(node, h, &msg);
+    case ARACHNAE_OP_STATUS_ACK_MMC:
+        arachnae_status_ack_mmc_unpack(payload, h->length, &node->msg.rx_status_ack_mmc);
+        mcp_on_status_ack_mmc(node, h, &node->msg.rx_status_ack_mmc);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_POST_REPORT: {
-        arachnae_post_report_t msg;
-        arachnae_post_report_unpack(payload, h->length, &msg);
-        mcp_on_post_report(node, h, &msg);
+    case ARACHNAE_OP_POST_REPORT:
+        arachnae_post_report_unpack(payload, h->length, &node->msg.rx_post_report);
+        mcp_on_post_report(node, h, &node->msg.rx_post_report);
         return ARACHNAE_OK;
-    }
     case ARACHNAE_OP_POST_REQ:
         mcp_on_post_req(node, h);
         return ARACHNAE_OK;
     case ARACHNAE_OP_XMIT_REQ:
         mcp_on_xmit_req(node, h);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_XMIT_RECORD: {
-        arachnae_xmit_record_t msg;
-        arachnae_xmit_record_unpack(payload, h->length, &msg);
-        mcp_on_xmit_record(node, h, &msg);
+    case ARACHNAE_OP_XMIT_RECORD:
+        arachnae_xmit_record_unpack(payload, h->length, &node->msg.rx_xmit_record);
+        mcp_on_xmit_record(node, h, &node->msg.rx_xmit_record);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_MOVE: {
-        arachnae_move_t msg;
-        arachnae_move_unpack(payload, h->length, &msg);
-        mcp_on_move(node, h, &msg);
+    case ARACHNAE_OP_MOVE:
+        arachnae_move_unpack(payload, h->length, &node->msg.rx_move);
+        mcp_on_move(node, h, &node->msg.rx_move);
         return ARACHNAE_OK;
-    }
     default:
         return ARACHNAE_OK;
     }
@@ -94,13 +82,12 @@ static arachnae_status deliver(mcp_node *node, const arachnae_header *h, const u
 
 arachnae_status mcp_dispatch(mcp_node *node, const uint8_t *frame, uint16_t len)
 {
-    arachnae_header h;
     arachnae_status st = arachnae_frame_check(frame, len, node->address);
     if (st != ARACHNAE_OK)
         return st;
-    arachnae_frame_header(frame, &h);
-    st = mcp_payload_check(h.opcode, frame + ARACHNAE_FRAME_PAYLOAD, h.length);
+    arachnae_frame_header(frame, &node->rx);
+    st = mcp_payload_check(node->rx.opcode, frame + ARACHNAE_FRAME_PAYLOAD, node->rx.length);
     if (st == ARACHNAE_OK)
-        st = deliver(node, &h, frame + ARACHNAE_FRAME_PAYLOAD);
-    return arachnae_unhandled_note(&node->unhandled, h.opcode, st);
+        st = deliver(node, &node->rx, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_unhandled_note(&node->unhandled, node->rx.opcode, st);
 }

@@ -44,12 +44,6 @@ arachnae_status mmc_payload_check(uint8_t opcode, const uint8_t *payload, uint8_
  * build and send the reply to a request (one reply buffer and one send for all of them). */
 static arachnae_status deliver(mmc_node *node, const arachnae_header *h, const uint8_t *payload)
 {
-    union {
-        arachnae_id_ack_t id_ack;
-        arachnae_status_ack_mmc_t status;
-    } reply;
-    uint8_t out[8];
-    uint16_t n = 0;
     arachnae_status st;
     switch (h->opcode) {
     case ARACHNAE_OP_INIT:
@@ -60,70 +54,59 @@ static arachnae_status deliver(mmc_node *node, const arachnae_header *h, const u
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
             return ARACHNAE_OK;
         /* seed 3.2.2: ID_ACK carries the node's own address */
-        reply.id_ack.address = node->address;
-        st = arachnae_id_ack_build(&reply.id_ack, h->src, node->address, out, sizeof out, &n);
+        node->msg.reply_id_ack.address = node->address;
+        st = arachnae_id_ack_build(&node->msg.reply_id_ack, h->src, node->address, node->out, sizeof node->out, &node->out_len);
         break;
     case ARACHNAE_OP_STATUS_REQ:
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
             return ARACHNAE_OK;
         /* seed 3.2.4: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_MMC) */
-        reply.status.gait = 0;
-        reply.status.direction = 0;
-        reply.status.leg = 0;
-        reply.status.error = 0;
-        mmc_on_status_req(node, h, &reply.status);
-        st = arachnae_status_ack_mmc_build(&reply.status, h->src, node->address, out, sizeof out, &n);
+        node->msg.reply_status.gait = 0;
+        node->msg.reply_status.direction = 0;
+        node->msg.reply_status.leg = 0;
+        node->msg.reply_status.error = 0;
+        mmc_on_status_req(node, h, &node->msg.reply_status);
+        st = arachnae_status_ack_mmc_build(&node->msg.reply_status, h->src, node->address, node->out, sizeof node->out, &node->out_len);
         break;
-    case ARACHNAE_OP_ID_ACK: {
-        arachnae_id_ack_t msg;
-        arachnae_id_ack_unpack(payload, h->length, &msg);
-        mmc_on_id_ack(node, h, &msg);
+    case ARACHNAE_OP_ID_ACK:
+        arachnae_id_ack_unpack(payload, h->length, &node->msg.rx_id_ack);
+        mmc_on_id_ack(node, h, &node->msg.rx_id_ack);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_STATUS_ACK_ORDER: {
-        arachnae_status_ack_order_t msg;
-        arachnae_status_ack_order_unpack(payload, h->length, &msg);
-        mmc_on_status_ack_order(node, h, &msg);
+    case ARACHNAE_OP_STATUS_ACK_ORDER:
+        arachnae_status_ack_order_unpack(payload, h->length, &node->msg.rx_status_ack_order);
+        mmc_on_status_ack_order(node, h, &node->msg.rx_status_ack_order);
         return ARACHNAE_OK;
-    }
     case ARACHNAE_OP_POST_QUERY:
         mmc_on_post_query(node, h);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_POST_REPORT: {
-        arachnae_post_report_t msg;
-        arachnae_post_report_unpack(payload, h->length, &msg);
-        mmc_on_post_report(node, h, &msg);
+    case ARACHNAE_OP_POST_REPORT:
+        arachnae_post_report_unpack(payload, h->length, &node->msg.rx_post_report);
+        mmc_on_post_report(node, h, &node->msg.rx_post_report);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_MOVE_RELAYED: {
-        arachnae_move_relayed_t msg;
-        arachnae_move_relayed_unpack(payload, h->length, &msg);
-        mmc_on_move_relayed(node, h, &msg);
+    case ARACHNAE_OP_MOVE_RELAYED:
+        arachnae_move_relayed_unpack(payload, h->length, &node->msg.rx_move_relayed);
+        mmc_on_move_relayed(node, h, &node->msg.rx_move_relayed);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_LEG_REPORT: {
-        arachnae_leg_report_t msg;
-        arachnae_leg_report_unpack(payload, h->length, &msg);
-        mmc_on_leg_report(node, h, &msg);
+    case ARACHNAE_OP_LEG_REPORT:
+        arachnae_leg_report_unpack(payload, h->length, &node->msg.rx_leg_report);
+        mmc_on_leg_report(node, h, &node->msg.rx_leg_report);
         return ARACHNAE_OK;
-    }
     default:
         return ARACHNAE_OK;
     }
     if (st == ARACHNAE_OK)
-        mmc_send(node, out, n);
+        mmc_send(node, node->out, node->out_len);
     return st;
 }
 
 arachnae_status mmc_dispatch(mmc_node *node, const uint8_t *frame, uint16_t len)
 {
-    arachnae_header h;
     arachnae_status st = arachnae_frame_check(frame, len, node->address);
     if (st != ARACHNAE_OK)
         return st;
-    arachnae_frame_header(frame, &h);
-    st = mmc_payload_check(h.opcode, frame + ARACHNAE_FRAME_PAYLOAD, h.length);
+    arachnae_frame_header(frame, &node->rx);
+    st = mmc_payload_check(node->rx.opcode, frame + ARACHNAE_FRAME_PAYLOAD, node->rx.length);
     if (st == ARACHNAE_OK)
-        st = deliver(node, &h, frame + ARACHNAE_FRAME_PAYLOAD);
-    return arachnae_unhandled_note(&node->unhandled, h.opcode, st);
+        st = deliver(node, &node->rx, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_unhandled_note(&node->unhandled, node->rx.opcode, st);
 }

@@ -36,12 +36,6 @@ arachnae_status np3_payload_check(uint8_t opcode, const uint8_t *payload, uint8_
  * build and send the reply to a request (one reply buffer and one send for all of them). */
 static arachnae_status deliver(np3_node *node, const arachnae_header *h, const uint8_t *payload)
 {
-    union {
-        arachnae_id_ack_t id_ack;
-        arachnae_status_ack_busy_t status;
-    } reply;
-    uint8_t out[7];
-    uint16_t n = 0;
     arachnae_status st;
     switch (h->opcode) {
     case ARACHNAE_OP_INIT:
@@ -52,43 +46,40 @@ static arachnae_status deliver(np3_node *node, const arachnae_header *h, const u
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
             return ARACHNAE_OK;
         /* seed 3.2.2: ID_ACK carries the node's own address */
-        reply.id_ack.address = node->address;
-        st = arachnae_id_ack_build(&reply.id_ack, h->src, node->address, out, sizeof out, &n);
+        node->msg.reply_id_ack.address = node->address;
+        st = arachnae_id_ack_build(&node->msg.reply_id_ack, h->src, node->address, node->out, sizeof node->out, &node->out_len);
         break;
     case ARACHNAE_OP_STATUS_REQ:
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
             return ARACHNAE_OK;
         /* seed 3.2.3: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_BUSY) */
-        reply.status.status = 0;
-        np3_on_status_req(node, h, &reply.status);
-        st = arachnae_status_ack_busy_build(&reply.status, h->src, node->address, out, sizeof out, &n);
+        node->msg.reply_status.status = 0;
+        np3_on_status_req(node, h, &node->msg.reply_status);
+        st = arachnae_status_ack_busy_build(&node->msg.reply_status, h->src, node->address, node->out, sizeof node->out, &node->out_len);
         break;
     case ARACHNAE_OP_XMIT_GRANT:
         np3_on_xmit_grant(node, h);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_DATA: {
-        arachnae_data_t msg;
-        arachnae_data_unpack(payload, h->length, &msg);
-        np3_on_data(node, h, &msg);
+    case ARACHNAE_OP_DATA:
+        arachnae_data_unpack(payload, h->length, &node->msg.rx_data);
+        np3_on_data(node, h, &node->msg.rx_data);
         return ARACHNAE_OK;
-    }
     default:
         return ARACHNAE_OK;
     }
     if (st == ARACHNAE_OK)
-        np3_send(node, out, n);
+        np3_send(node, node->out, node->out_len);
     return st;
 }
 
 arachnae_status np3_dispatch(np3_node *node, const uint8_t *frame, uint16_t len)
 {
-    arachnae_header h;
     arachnae_status st = arachnae_frame_check(frame, len, node->address);
     if (st != ARACHNAE_OK)
         return st;
-    arachnae_frame_header(frame, &h);
-    st = np3_payload_check(h.opcode, frame + ARACHNAE_FRAME_PAYLOAD, h.length);
+    arachnae_frame_header(frame, &node->rx);
+    st = np3_payload_check(node->rx.opcode, frame + ARACHNAE_FRAME_PAYLOAD, node->rx.length);
     if (st == ARACHNAE_OK)
-        st = deliver(node, &h, frame + ARACHNAE_FRAME_PAYLOAD);
-    return arachnae_unhandled_note(&node->unhandled, h.opcode, st);
+        st = deliver(node, &node->rx, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_unhandled_note(&node->unhandled, node->rx.opcode, st);
 }

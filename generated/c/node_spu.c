@@ -59,12 +59,6 @@ arachnae_status spu_payload_check(uint8_t opcode, const uint8_t *payload, uint8_
  * build and send the reply to a request (one reply buffer and one send for all of them). */
 static arachnae_status deliver(spu_node *node, const arachnae_header *h, const uint8_t *payload)
 {
-    union {
-        arachnae_id_ack_t id_ack;
-        arachnae_status_ack_busy_t status;
-    } reply;
-    uint8_t out[7];
-    uint16_t n = 0;
     arachnae_status st;
     switch (h->opcode) {
     case ARACHNAE_OP_INIT:
@@ -75,35 +69,29 @@ static arachnae_status deliver(spu_node *node, const arachnae_header *h, const u
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
             return ARACHNAE_OK;
         /* seed 3.2.2: ID_ACK carries the node's own address */
-        reply.id_ack.address = node->address;
-        st = arachnae_id_ack_build(&reply.id_ack, h->src, node->address, out, sizeof out, &n);
+        node->msg.reply_id_ack.address = node->address;
+        st = arachnae_id_ack_build(&node->msg.reply_id_ack, h->src, node->address, node->out, sizeof node->out, &node->out_len);
         break;
     case ARACHNAE_OP_STATUS_REQ:
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
             return ARACHNAE_OK;
         /* seed 3.2.3: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_BUSY) */
-        reply.status.status = 0;
-        spu_on_status_req(node, h, &reply.status);
-        st = arachnae_status_ack_busy_build(&reply.status, h->src, node->address, out, sizeof out, &n);
+        node->msg.reply_status.status = 0;
+        spu_on_status_req(node, h, &node->msg.reply_status);
+        st = arachnae_status_ack_busy_build(&node->msg.reply_status, h->src, node->address, node->out, sizeof node->out, &node->out_len);
         break;
-    case ARACHNAE_OP_ID_ACK: {
-        arachnae_id_ack_t msg;
-        arachnae_id_ack_unpack(payload, h->length, &msg);
-        spu_on_id_ack(node, h, &msg);
+    case ARACHNAE_OP_ID_ACK:
+        arachnae_id_ack_unpack(payload, h->length, &node->msg.rx_id_ack);
+        spu_on_id_ack(node, h, &node->msg.rx_id_ack);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_STATUS_ACK_ORDER: {
-        arachnae_status_ack_order_t msg;
-        arachnae_status_ack_order_unpack(payload, h->length, &msg);
-        spu_on_status_ack_order(node, h, &msg);
+    case ARACHNAE_OP_STATUS_ACK_ORDER:
+        arachnae_status_ack_order_unpack(payload, h->length, &node->msg.rx_status_ack_order);
+        spu_on_status_ack_order(node, h, &node->msg.rx_status_ack_order);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_STATUS_ACK_RANGE: {
-        arachnae_status_ack_range_t msg;
-        arachnae_status_ack_range_unpack(payload, h->length, &msg);
-        spu_on_status_ack_range(node, h, &msg);
+    case ARACHNAE_OP_STATUS_ACK_RANGE:
+        arachnae_status_ack_range_unpack(payload, h->length, &node->msg.rx_status_ack_range);
+        spu_on_status_ack_range(node, h, &node->msg.rx_status_ack_range);
         return ARACHNAE_OK;
-    }
     case ARACHNAE_OP_POST_QUERY:
         spu_on_post_query(node, h);
         return ARACHNAE_OK;
@@ -122,65 +110,50 @@ static arachnae_status deliver(spu_node *node, const arachnae_header *h, const u
     case ARACHNAE_OP_OBJ_BOTH:
         spu_on_obj_both(node, h);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_XMIT_DATA_USRC: {
-        arachnae_xmit_data_usrc_t msg;
-        arachnae_xmit_data_usrc_unpack(payload, h->length, &msg);
-        spu_on_xmit_data_usrc(node, h, &msg);
+    case ARACHNAE_OP_XMIT_DATA_USRC:
+        arachnae_xmit_data_usrc_unpack(payload, h->length, &node->msg.rx_xmit_data_usrc);
+        spu_on_xmit_data_usrc(node, h, &node->msg.rx_xmit_data_usrc);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_XMIT_DATA_TPSC: {
-        arachnae_xmit_data_tpsc_t msg;
-        arachnae_xmit_data_tpsc_unpack(payload, h->length, &msg);
-        spu_on_xmit_data_tpsc(node, h, &msg);
+    case ARACHNAE_OP_XMIT_DATA_TPSC:
+        arachnae_xmit_data_tpsc_unpack(payload, h->length, &node->msg.rx_xmit_data_tpsc);
+        spu_on_xmit_data_tpsc(node, h, &node->msg.rx_xmit_data_tpsc);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_XMIT_DATA_IRRC: {
-        arachnae_xmit_data_irrc_t msg;
-        arachnae_xmit_data_irrc_unpack(payload, h->length, &msg);
-        spu_on_xmit_data_irrc(node, h, &msg);
+    case ARACHNAE_OP_XMIT_DATA_IRRC:
+        arachnae_xmit_data_irrc_unpack(payload, h->length, &node->msg.rx_xmit_data_irrc);
+        spu_on_xmit_data_irrc(node, h, &node->msg.rx_xmit_data_irrc);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_XMIT_DATA_ISC: {
-        arachnae_xmit_data_isc_t msg;
-        arachnae_xmit_data_isc_unpack(payload, h->length, &msg);
-        spu_on_xmit_data_isc(node, h, &msg);
+    case ARACHNAE_OP_XMIT_DATA_ISC:
+        arachnae_xmit_data_isc_unpack(payload, h->length, &node->msg.rx_xmit_data_isc);
+        spu_on_xmit_data_isc(node, h, &node->msg.rx_xmit_data_isc);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_XMIT_DATA_TSC: {
-        arachnae_xmit_data_tsc_t msg;
-        arachnae_xmit_data_tsc_unpack(payload, h->length, &msg);
-        spu_on_xmit_data_tsc(node, h, &msg);
+    case ARACHNAE_OP_XMIT_DATA_TSC:
+        arachnae_xmit_data_tsc_unpack(payload, h->length, &node->msg.rx_xmit_data_tsc);
+        spu_on_xmit_data_tsc(node, h, &node->msg.rx_xmit_data_tsc);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_XMIT_DATA_LSC: {
-        arachnae_xmit_data_lsc_t msg;
-        arachnae_xmit_data_lsc_unpack(payload, h->length, &msg);
-        spu_on_xmit_data_lsc(node, h, &msg);
+    case ARACHNAE_OP_XMIT_DATA_LSC:
+        arachnae_xmit_data_lsc_unpack(payload, h->length, &node->msg.rx_xmit_data_lsc);
+        spu_on_xmit_data_lsc(node, h, &node->msg.rx_xmit_data_lsc);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_XMIT_DATA_PSC: {
-        arachnae_xmit_data_psc_t msg;
-        arachnae_xmit_data_psc_unpack(payload, h->length, &msg);
-        spu_on_xmit_data_psc(node, h, &msg);
+    case ARACHNAE_OP_XMIT_DATA_PSC:
+        arachnae_xmit_data_psc_unpack(payload, h->length, &node->msg.rx_xmit_data_psc);
+        spu_on_xmit_data_psc(node, h, &node->msg.rx_xmit_data_psc);
         return ARACHNAE_OK;
-    }
     default:
         return ARACHNAE_OK;
     }
     if (st == ARACHNAE_OK)
-        spu_send(node, out, n);
+        spu_send(node, node->out, node->out_len);
     return st;
 }
 
 arachnae_status spu_dispatch(spu_node *node, const uint8_t *frame, uint16_t len)
 {
-    arachnae_header h;
     arachnae_status st = arachnae_frame_check(frame, len, node->address);
     if (st != ARACHNAE_OK)
         return st;
-    arachnae_frame_header(frame, &h);
-    st = spu_payload_check(h.opcode, frame + ARACHNAE_FRAME_PAYLOAD, h.length);
+    arachnae_frame_header(frame, &node->rx);
+    st = spu_payload_check(node->rx.opcode, frame + ARACHNAE_FRAME_PAYLOAD, node->rx.length);
     if (st == ARACHNAE_OK)
-        st = deliver(node, &h, frame + ARACHNAE_FRAME_PAYLOAD);
-    return arachnae_unhandled_note(&node->unhandled, h.opcode, st);
+        st = deliver(node, &node->rx, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_unhandled_note(&node->unhandled, node->rx.opcode, st);
 }

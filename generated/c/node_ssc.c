@@ -39,12 +39,6 @@ arachnae_status ssc_payload_check(uint8_t opcode, const uint8_t *payload, uint8_
  * build and send the reply to a request (one reply buffer and one send for all of them). */
 static arachnae_status deliver(ssc_node *node, const arachnae_header *h, const uint8_t *payload)
 {
-    union {
-        arachnae_id_ack_t id_ack;
-        arachnae_status_ack_busy_t status;
-    } reply;
-    uint8_t out[7];
-    uint16_t n = 0;
     arachnae_status st;
     switch (h->opcode) {
     case ARACHNAE_OP_INIT:
@@ -55,52 +49,45 @@ static arachnae_status deliver(ssc_node *node, const arachnae_header *h, const u
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
             return ARACHNAE_OK;
         /* seed 3.2.2: ID_ACK carries the node's own address */
-        reply.id_ack.address = node->address;
-        st = arachnae_id_ack_build(&reply.id_ack, h->src, node->address, out, sizeof out, &n);
+        node->msg.reply_id_ack.address = node->address;
+        st = arachnae_id_ack_build(&node->msg.reply_id_ack, h->src, node->address, node->out, sizeof node->out, &node->out_len);
         break;
     case ARACHNAE_OP_STATUS_REQ:
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
             return ARACHNAE_OK;
         /* seed 3.2.3: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_BUSY) */
-        reply.status.status = 0;
-        ssc_on_status_req(node, h, &reply.status);
-        st = arachnae_status_ack_busy_build(&reply.status, h->src, node->address, out, sizeof out, &n);
+        node->msg.reply_status.status = 0;
+        ssc_on_status_req(node, h, &node->msg.reply_status);
+        st = arachnae_status_ack_busy_build(&node->msg.reply_status, h->src, node->address, node->out, sizeof node->out, &node->out_len);
         break;
-    case ARACHNAE_OP_SETUP: {
-        arachnae_setup_t msg;
-        arachnae_setup_unpack(payload, h->length, &msg);
-        ssc_on_setup(node, h, &msg);
+    case ARACHNAE_OP_SETUP:
+        arachnae_setup_unpack(payload, h->length, &node->msg.rx_setup);
+        ssc_on_setup(node, h, &node->msg.rx_setup);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_SPEAK: {
-        arachnae_speak_t msg;
-        arachnae_speak_unpack(payload, h->length, &msg);
-        ssc_on_speak(node, h, &msg);
+    case ARACHNAE_OP_SPEAK:
+        arachnae_speak_unpack(payload, h->length, &node->msg.rx_speak);
+        ssc_on_speak(node, h, &node->msg.rx_speak);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_SPEAK_RESIDENT: {
-        arachnae_speak_resident_t msg;
-        arachnae_speak_resident_unpack(payload, h->length, &msg);
-        ssc_on_speak_resident(node, h, &msg);
+    case ARACHNAE_OP_SPEAK_RESIDENT:
+        arachnae_speak_resident_unpack(payload, h->length, &node->msg.rx_speak_resident);
+        ssc_on_speak_resident(node, h, &node->msg.rx_speak_resident);
         return ARACHNAE_OK;
-    }
     default:
         return ARACHNAE_OK;
     }
     if (st == ARACHNAE_OK)
-        ssc_send(node, out, n);
+        ssc_send(node, node->out, node->out_len);
     return st;
 }
 
 arachnae_status ssc_dispatch(ssc_node *node, const uint8_t *frame, uint16_t len)
 {
-    arachnae_header h;
     arachnae_status st = arachnae_frame_check(frame, len, node->address);
     if (st != ARACHNAE_OK)
         return st;
-    arachnae_frame_header(frame, &h);
-    st = ssc_payload_check(h.opcode, frame + ARACHNAE_FRAME_PAYLOAD, h.length);
+    arachnae_frame_header(frame, &node->rx);
+    st = ssc_payload_check(node->rx.opcode, frame + ARACHNAE_FRAME_PAYLOAD, node->rx.length);
     if (st == ARACHNAE_OK)
-        st = deliver(node, &h, frame + ARACHNAE_FRAME_PAYLOAD);
-    return arachnae_unhandled_note(&node->unhandled, h.opcode, st);
+        st = deliver(node, &node->rx, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_unhandled_note(&node->unhandled, node->rx.opcode, st);
 }

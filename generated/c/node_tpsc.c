@@ -35,12 +35,6 @@ arachnae_status tpsc_payload_check(uint8_t opcode, const uint8_t *payload, uint8
  * build and send the reply to a request (one reply buffer and one send for all of them). */
 static arachnae_status deliver(tpsc_node *node, const arachnae_header *h, const uint8_t *payload)
 {
-    union {
-        arachnae_id_ack_t id_ack;
-        arachnae_status_ack_order_t status;
-    } reply;
-    uint8_t out[7];
-    uint16_t n = 0;
     arachnae_status st;
     (void)payload;
     switch (h->opcode) {
@@ -52,16 +46,16 @@ static arachnae_status deliver(tpsc_node *node, const arachnae_header *h, const 
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
             return ARACHNAE_OK;
         /* seed 3.2.2: ID_ACK carries the node's own address */
-        reply.id_ack.address = node->address;
-        st = arachnae_id_ack_build(&reply.id_ack, h->src, node->address, out, sizeof out, &n);
+        node->msg.reply_id_ack.address = node->address;
+        st = arachnae_id_ack_build(&node->msg.reply_id_ack, h->src, node->address, node->out, sizeof node->out, &node->out_len);
         break;
     case ARACHNAE_OP_STATUS_REQ:
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
             return ARACHNAE_OK;
         /* seed 3.2.10: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_ORDER) */
-        reply.status.status = 0;
-        tpsc_on_status_req(node, h, &reply.status);
-        st = arachnae_status_ack_order_build(&reply.status, h->src, node->address, out, sizeof out, &n);
+        node->msg.reply_status.status = 0;
+        tpsc_on_status_req(node, h, &node->msg.reply_status);
+        st = arachnae_status_ack_order_build(&node->msg.reply_status, h->src, node->address, node->out, sizeof node->out, &node->out_len);
         break;
     case ARACHNAE_OP_XMIT_DATA:
         tpsc_on_xmit_data(node, h);
@@ -70,19 +64,18 @@ static arachnae_status deliver(tpsc_node *node, const arachnae_header *h, const 
         return ARACHNAE_OK;
     }
     if (st == ARACHNAE_OK)
-        tpsc_send(node, out, n);
+        tpsc_send(node, node->out, node->out_len);
     return st;
 }
 
 arachnae_status tpsc_dispatch(tpsc_node *node, const uint8_t *frame, uint16_t len)
 {
-    arachnae_header h;
     arachnae_status st = arachnae_frame_check(frame, len, node->address);
     if (st != ARACHNAE_OK)
         return st;
-    arachnae_frame_header(frame, &h);
-    st = tpsc_payload_check(h.opcode, frame + ARACHNAE_FRAME_PAYLOAD, h.length);
+    arachnae_frame_header(frame, &node->rx);
+    st = tpsc_payload_check(node->rx.opcode, frame + ARACHNAE_FRAME_PAYLOAD, node->rx.length);
     if (st == ARACHNAE_OK)
-        st = deliver(node, &h, frame + ARACHNAE_FRAME_PAYLOAD);
-    return arachnae_unhandled_note(&node->unhandled, h.opcode, st);
+        st = deliver(node, &node->rx, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_unhandled_note(&node->unhandled, node->rx.opcode, st);
 }

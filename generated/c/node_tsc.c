@@ -36,12 +36,6 @@ arachnae_status tsc_payload_check(uint8_t opcode, const uint8_t *payload, uint8_
  * build and send the reply to a request (one reply buffer and one send for all of them). */
 static arachnae_status deliver(tsc_node *node, const arachnae_header *h, const uint8_t *payload)
 {
-    union {
-        arachnae_id_ack_t id_ack;
-        arachnae_status_ack_order_t status;
-    } reply;
-    uint8_t out[7];
-    uint16_t n = 0;
     arachnae_status st;
     switch (h->opcode) {
     case ARACHNAE_OP_INIT:
@@ -52,43 +46,40 @@ static arachnae_status deliver(tsc_node *node, const arachnae_header *h, const u
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
             return ARACHNAE_OK;
         /* seed 3.2.2: ID_ACK carries the node's own address */
-        reply.id_ack.address = node->address;
-        st = arachnae_id_ack_build(&reply.id_ack, h->src, node->address, out, sizeof out, &n);
+        node->msg.reply_id_ack.address = node->address;
+        st = arachnae_id_ack_build(&node->msg.reply_id_ack, h->src, node->address, node->out, sizeof node->out, &node->out_len);
         break;
     case ARACHNAE_OP_STATUS_REQ:
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
             return ARACHNAE_OK;
         /* seed 3.2.10: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_ORDER) */
-        reply.status.status = 0;
-        tsc_on_status_req(node, h, &reply.status);
-        st = arachnae_status_ack_order_build(&reply.status, h->src, node->address, out, sizeof out, &n);
+        node->msg.reply_status.status = 0;
+        tsc_on_status_req(node, h, &node->msg.reply_status);
+        st = arachnae_status_ack_order_build(&node->msg.reply_status, h->src, node->address, node->out, sizeof node->out, &node->out_len);
         break;
     case ARACHNAE_OP_XMIT_DATA:
         tsc_on_xmit_data(node, h);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_SET_ALARM_TSC: {
-        arachnae_set_alarm_tsc_t msg;
-        arachnae_set_alarm_tsc_unpack(payload, h->length, &msg);
-        tsc_on_set_alarm_tsc(node, h, &msg);
+    case ARACHNAE_OP_SET_ALARM_TSC:
+        arachnae_set_alarm_tsc_unpack(payload, h->length, &node->msg.rx_set_alarm_tsc);
+        tsc_on_set_alarm_tsc(node, h, &node->msg.rx_set_alarm_tsc);
         return ARACHNAE_OK;
-    }
     default:
         return ARACHNAE_OK;
     }
     if (st == ARACHNAE_OK)
-        tsc_send(node, out, n);
+        tsc_send(node, node->out, node->out_len);
     return st;
 }
 
 arachnae_status tsc_dispatch(tsc_node *node, const uint8_t *frame, uint16_t len)
 {
-    arachnae_header h;
     arachnae_status st = arachnae_frame_check(frame, len, node->address);
     if (st != ARACHNAE_OK)
         return st;
-    arachnae_frame_header(frame, &h);
-    st = tsc_payload_check(h.opcode, frame + ARACHNAE_FRAME_PAYLOAD, h.length);
+    arachnae_frame_header(frame, &node->rx);
+    st = tsc_payload_check(node->rx.opcode, frame + ARACHNAE_FRAME_PAYLOAD, node->rx.length);
     if (st == ARACHNAE_OK)
-        st = deliver(node, &h, frame + ARACHNAE_FRAME_PAYLOAD);
-    return arachnae_unhandled_note(&node->unhandled, h.opcode, st);
+        st = deliver(node, &node->rx, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_unhandled_note(&node->unhandled, node->rx.opcode, st);
 }

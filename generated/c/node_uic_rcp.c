@@ -38,12 +38,6 @@ arachnae_status uic_rcp_payload_check(uint8_t opcode, const uint8_t *payload, ui
  * build and send the reply to a request (one reply buffer and one send for all of them). */
 static arachnae_status deliver(uic_rcp_node *node, const arachnae_header *h, const uint8_t *payload)
 {
-    union {
-        arachnae_id_ack_t id_ack;
-        arachnae_status_ack_busy_t status;
-    } reply;
-    uint8_t out[7];
-    uint16_t n = 0;
     arachnae_status st;
     switch (h->opcode) {
     case ARACHNAE_OP_INIT:
@@ -54,49 +48,44 @@ static arachnae_status deliver(uic_rcp_node *node, const arachnae_header *h, con
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
             return ARACHNAE_OK;
         /* seed 3.2.2: ID_ACK carries the node's own address */
-        reply.id_ack.address = node->address;
-        st = arachnae_id_ack_build(&reply.id_ack, h->src, node->address, out, sizeof out, &n);
+        node->msg.reply_id_ack.address = node->address;
+        st = arachnae_id_ack_build(&node->msg.reply_id_ack, h->src, node->address, node->out, sizeof node->out, &node->out_len);
         break;
     case ARACHNAE_OP_STATUS_REQ:
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
             return ARACHNAE_OK;
         /* seed 3.2.3: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_BUSY) */
-        reply.status.status = 0;
-        uic_rcp_on_status_req(node, h, &reply.status);
-        st = arachnae_status_ack_busy_build(&reply.status, h->src, node->address, out, sizeof out, &n);
+        node->msg.reply_status.status = 0;
+        uic_rcp_on_status_req(node, h, &node->msg.reply_status);
+        st = arachnae_status_ack_busy_build(&node->msg.reply_status, h->src, node->address, node->out, sizeof node->out, &node->out_len);
         break;
     case ARACHNAE_OP_XMIT_GRANT:
         uic_rcp_on_xmit_grant(node, h);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_LCD_TEXT: {
-        arachnae_lcd_text_t msg;
-        arachnae_lcd_text_unpack(payload, h->length, &msg);
-        uic_rcp_on_lcd_text(node, h, &msg);
+    case ARACHNAE_OP_LCD_TEXT:
+        arachnae_lcd_text_unpack(payload, h->length, &node->msg.rx_lcd_text);
+        uic_rcp_on_lcd_text(node, h, &node->msg.rx_lcd_text);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_UIC_ALERT: {
-        arachnae_uic_alert_t msg;
-        arachnae_uic_alert_unpack(payload, h->length, &msg);
-        uic_rcp_on_uic_alert(node, h, &msg);
+    case ARACHNAE_OP_UIC_ALERT:
+        arachnae_uic_alert_unpack(payload, h->length, &node->msg.rx_uic_alert);
+        uic_rcp_on_uic_alert(node, h, &node->msg.rx_uic_alert);
         return ARACHNAE_OK;
-    }
     default:
         return ARACHNAE_OK;
     }
     if (st == ARACHNAE_OK)
-        uic_rcp_send(node, out, n);
+        uic_rcp_send(node, node->out, node->out_len);
     return st;
 }
 
 arachnae_status uic_rcp_dispatch(uic_rcp_node *node, const uint8_t *frame, uint16_t len)
 {
-    arachnae_header h;
     arachnae_status st = arachnae_frame_check(frame, len, node->address);
     if (st != ARACHNAE_OK)
         return st;
-    arachnae_frame_header(frame, &h);
-    st = uic_rcp_payload_check(h.opcode, frame + ARACHNAE_FRAME_PAYLOAD, h.length);
+    arachnae_frame_header(frame, &node->rx);
+    st = uic_rcp_payload_check(node->rx.opcode, frame + ARACHNAE_FRAME_PAYLOAD, node->rx.length);
     if (st == ARACHNAE_OK)
-        st = deliver(node, &h, frame + ARACHNAE_FRAME_PAYLOAD);
-    return arachnae_unhandled_note(&node->unhandled, h.opcode, st);
+        st = deliver(node, &node->rx, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_unhandled_note(&node->unhandled, node->rx.opcode, st);
 }

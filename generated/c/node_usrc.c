@@ -41,12 +41,6 @@ arachnae_status usrc_payload_check(uint8_t opcode, const uint8_t *payload, uint8
  * build and send the reply to a request (one reply buffer and one send for all of them). */
 static arachnae_status deliver(usrc_node *node, const arachnae_header *h, const uint8_t *payload)
 {
-    union {
-        arachnae_id_ack_t id_ack;
-        arachnae_status_ack_range_t status;
-    } reply;
-    uint8_t out[7];
-    uint16_t n = 0;
     arachnae_status st;
     switch (h->opcode) {
     case ARACHNAE_OP_INIT:
@@ -57,29 +51,25 @@ static arachnae_status deliver(usrc_node *node, const arachnae_header *h, const 
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
             return ARACHNAE_OK;
         /* seed 3.2.2: ID_ACK carries the node's own address */
-        reply.id_ack.address = node->address;
-        st = arachnae_id_ack_build(&reply.id_ack, h->src, node->address, out, sizeof out, &n);
+        node->msg.reply_id_ack.address = node->address;
+        st = arachnae_id_ack_build(&node->msg.reply_id_ack, h->src, node->address, node->out, sizeof node->out, &node->out_len);
         break;
     case ARACHNAE_OP_STATUS_REQ:
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
             return ARACHNAE_OK;
         /* seed 3.2.11: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_RANGE) */
-        reply.status.status = 0;
-        usrc_on_status_req(node, h, &reply.status);
-        st = arachnae_status_ack_range_build(&reply.status, h->src, node->address, out, sizeof out, &n);
+        node->msg.reply_status.status = 0;
+        usrc_on_status_req(node, h, &node->msg.reply_status);
+        st = arachnae_status_ack_range_build(&node->msg.reply_status, h->src, node->address, node->out, sizeof node->out, &node->out_len);
         break;
-    case ARACHNAE_OP_HEAD_SET_ABS: {
-        arachnae_head_set_abs_t msg;
-        arachnae_head_set_abs_unpack(payload, h->length, &msg);
-        usrc_on_head_set_abs(node, h, &msg);
+    case ARACHNAE_OP_HEAD_SET_ABS:
+        arachnae_head_set_abs_unpack(payload, h->length, &node->msg.rx_head_set_abs);
+        usrc_on_head_set_abs(node, h, &node->msg.rx_head_set_abs);
         return ARACHNAE_OK;
-    }
-    case ARACHNAE_OP_HEAD_SET_REL: {
-        arachnae_head_set_rel_t msg;
-        arachnae_head_set_rel_unpack(payload, h->length, &msg);
-        usrc_on_head_set_rel(node, h, &msg);
+    case ARACHNAE_OP_HEAD_SET_REL:
+        arachnae_head_set_rel_unpack(payload, h->length, &node->msg.rx_head_set_rel);
+        usrc_on_head_set_rel(node, h, &node->msg.rx_head_set_rel);
         return ARACHNAE_OK;
-    }
     case ARACHNAE_OP_HEAD_STEP:
         usrc_on_head_step(node, h);
         return ARACHNAE_OK;
@@ -96,19 +86,18 @@ static arachnae_status deliver(usrc_node *node, const arachnae_header *h, const 
         return ARACHNAE_OK;
     }
     if (st == ARACHNAE_OK)
-        usrc_send(node, out, n);
+        usrc_send(node, node->out, node->out_len);
     return st;
 }
 
 arachnae_status usrc_dispatch(usrc_node *node, const uint8_t *frame, uint16_t len)
 {
-    arachnae_header h;
     arachnae_status st = arachnae_frame_check(frame, len, node->address);
     if (st != ARACHNAE_OK)
         return st;
-    arachnae_frame_header(frame, &h);
-    st = usrc_payload_check(h.opcode, frame + ARACHNAE_FRAME_PAYLOAD, h.length);
+    arachnae_frame_header(frame, &node->rx);
+    st = usrc_payload_check(node->rx.opcode, frame + ARACHNAE_FRAME_PAYLOAD, node->rx.length);
     if (st == ARACHNAE_OK)
-        st = deliver(node, &h, frame + ARACHNAE_FRAME_PAYLOAD);
-    return arachnae_unhandled_note(&node->unhandled, h.opcode, st);
+        st = deliver(node, &node->rx, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_unhandled_note(&node->unhandled, node->rx.opcode, st);
 }

@@ -331,6 +331,11 @@ class RoleView:
         return [m for m in self.receives if not m.has_fields]
 
     @property
+    def field_others(self) -> list[MessageView]:
+        """Received messages with fields that reach a behaviour callback (decoded into node->msg)."""
+        return [m for m in self.others if m.has_fields]
+
+    @property
     def field_receives(self) -> list[MessageView]:
         return [m for m in self.receives if m.has_fields]
 
