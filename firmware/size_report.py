@@ -6,10 +6,15 @@ they count only what --gc-sections kept, split by where it came from:
     skeleton   generated/c node_<role>.c
     firmware   main.c, the board HAL and the behaviour (or an empty stub)
     runtime    C start-up, libgcc, libc, vector table
-Stack: worst case over the static call graph (objdump calls + -fstack-usage frames);
-the parser's one indirect call is resolved to the role's payload check.
+Stack: worst case over the static call graph (objdump calls + -fstack-usage frames, plus
+the return address each call pushes), deepest path first; the parser's one indirect call is
+resolved to the role's payload check. parse = the RX interrupt's parser path, dispatch = the
+skeleton without the behaviour, node = main with all it calls plus the deepest interrupt.
+Issue 15: the budgets (a sensor role in 1 KiB, any role in 2 KiB, the TPSC within 1.5x of the
+hand-written baseline) and, with --nanopb, nanopb's codec bytes for the same roles beside ours.
 Writes build/size.json; prints the tables. Exit 1 if the codec has data or bss of
-its own or an image could not be analysed.
+its own or an image could not be analysed (a budget overrun is reported, tests/firmware
+test_size.py holds the limits).
 """
 from __future__ import annotations
 
