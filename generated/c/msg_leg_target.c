@@ -56,7 +56,7 @@ arachnae_status arachnae_leg_target_decode(const uint8_t *payload, uint8_t len, 
     return st;
 }
 
-/* RANGE on the struct: inlined into encode and build, which then keep no frame of their own. */
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
 static inline arachnae_status check(const arachnae_leg_target_t *m)
 {
     if (!(m->phase <= 3u))
@@ -77,7 +77,7 @@ arachnae_status arachnae_leg_target_check(const arachnae_leg_target_t *m)
     return check(m);
 }
 
-/* The bytes of a checked struct; the caller made room for arachnae_leg_target_size(m) bytes. */
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
 static uint8_t pack(const arachnae_leg_target_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->phase & 0xFFu));

@@ -41,7 +41,7 @@ arachnae_status arachnae_post_report_decode(const uint8_t *payload, uint8_t len,
     return st;
 }
 
-/* RANGE on the struct: inlined into encode and build, which then keep no frame of their own. */
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
 static inline arachnae_status check(const arachnae_post_report_t *m)
 {
     uint16_t i;
@@ -58,7 +58,7 @@ arachnae_status arachnae_post_report_check(const arachnae_post_report_t *m)
     return check(m);
 }
 
-/* The bytes of a checked struct; the caller made room for arachnae_post_report_size(m) bytes. */
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
 static uint8_t pack(const arachnae_post_report_t *m, uint8_t *payload)
 {
     uint8_t i;

@@ -38,7 +38,7 @@ arachnae_status arachnae_speak_decode(const uint8_t *payload, uint8_t len, arach
     return st;
 }
 
-/* RANGE on the struct: inlined into encode and build, which then keep no frame of their own. */
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
 static inline arachnae_status check(const arachnae_speak_t *m)
 {
     if (!(m->length >= 1u && m->length <= 253u))
@@ -51,7 +51,7 @@ arachnae_status arachnae_speak_check(const arachnae_speak_t *m)
     return check(m);
 }
 
-/* The bytes of a checked struct; the caller made room for arachnae_speak_size(m) bytes. */
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
 static uint8_t pack(const arachnae_speak_t *m, uint8_t *payload)
 {
     uint8_t i;

@@ -39,7 +39,7 @@ arachnae_status arachnae_speak_resident_decode(const uint8_t *payload, uint8_t l
     return st;
 }
 
-/* RANGE on the struct: inlined into encode and build, which then keep no frame of their own. */
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
 static inline arachnae_status check(const arachnae_speak_resident_t *m)
 {
     if (!(m->length <= 0u))
@@ -54,7 +54,7 @@ arachnae_status arachnae_speak_resident_check(const arachnae_speak_resident_t *m
     return check(m);
 }
 
-/* The bytes of a checked struct; the caller made room for arachnae_speak_resident_size(m) bytes. */
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
 static uint8_t pack(const arachnae_speak_resident_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->repeat & 0xFFu));

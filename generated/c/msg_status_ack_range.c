@@ -32,7 +32,7 @@ arachnae_status arachnae_status_ack_range_decode(const uint8_t *payload, uint8_t
     return st;
 }
 
-/* RANGE on the struct: inlined into encode and build, which then keep no frame of their own. */
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
 static inline arachnae_status check(const arachnae_status_ack_range_t *m)
 {
     if (!(m->status <= 2u))
@@ -45,7 +45,7 @@ arachnae_status arachnae_status_ack_range_check(const arachnae_status_ack_range_
     return check(m);
 }
 
-/* The bytes of a checked struct; the caller made room for arachnae_status_ack_range_size(m) bytes. */
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
 static uint8_t pack(const arachnae_status_ack_range_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->status & 0xFFu));

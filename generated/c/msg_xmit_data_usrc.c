@@ -33,7 +33,7 @@ arachnae_status arachnae_xmit_data_usrc_decode(const uint8_t *payload, uint8_t l
     return st;
 }
 
-/* RANGE on the struct: inlined into encode and build, which then keep no frame of their own. */
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
 static inline arachnae_status check(const arachnae_xmit_data_usrc_t *m)
 {
     if (!(m->angle <= 359u))
@@ -46,7 +46,7 @@ arachnae_status arachnae_xmit_data_usrc_check(const arachnae_xmit_data_usrc_t *m
     return check(m);
 }
 
-/* The bytes of a checked struct; the caller made room for arachnae_xmit_data_usrc_size(m) bytes. */
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
 static uint8_t pack(const arachnae_xmit_data_usrc_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->distance & 0xFFu));
