@@ -13,7 +13,7 @@ typedef char arachnae_spec_hash_ok[(ARACHNAE_SPEC_HASH == 0x2B0B3090UL) ? 1 : -1
 #if defined(__AVR__) && !defined(ARACHNAE_CRC_BITWISE)
 #define ARACHNAE_CRC_BITWISE
 #endif
-uint16_t arachnae_crc16_update(uint16_t crc, uint8_t byte)
+static inline uint16_t crc_step(uint16_t crc, uint8_t byte)
 {
 #ifdef ARACHNAE_CRC_BITWISE
     uint8_t i;
@@ -31,12 +31,18 @@ uint16_t arachnae_crc16_update(uint16_t crc, uint8_t byte)
 #endif
 }
 
+uint16_t arachnae_crc16_update(uint16_t crc, uint8_t byte)
+{
+    return crc_step(crc, byte);
+}
+
+/* the step inlined: a node that only checks and seals frames links this function alone */
 uint16_t arachnae_crc16(const uint8_t *data, uint16_t len)
 {
     uint16_t crc = ARACHNAE_CRC_INIT;
     uint16_t i;
     for (i = 0; i < len; i++)
-        crc = arachnae_crc16_update(crc, data[i]);
+        crc = crc_step(crc, data[i]);
     return (uint16_t)(crc ^ ARACHNAE_CRC_XOROUT);
 }
 
