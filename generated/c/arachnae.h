@@ -443,10 +443,21 @@ uint16_t arachnae_crc16_update(uint16_t crc, uint8_t byte);
 /* CRC over `len` bytes, init and xorout applied. */
 uint16_t arachnae_crc16(const uint8_t *data, uint16_t len);
 /* Reads the header of a frame of at least ARACHNAE_FRAME_HEADER_SIZE bytes. */
-void arachnae_frame_header(const uint8_t *frame, arachnae_header *h);
+static inline void arachnae_frame_header(const uint8_t *frame, arachnae_header *h)
+{
+    h->dst = frame[ARACHNAE_FRAME_DST];
+    h->src = frame[ARACHNAE_FRAME_SRC];
+    h->opcode = frame[ARACHNAE_FRAME_OPCODE];
+    h->length = frame[ARACHNAE_FRAME_LENGTH];
+}
 /* The payload is already at frame + ARACHNAE_FRAME_PAYLOAD: write header and CRC. */
 arachnae_status arachnae_frame_finish(uint8_t *frame, uint16_t cap, uint8_t dst, uint8_t src, uint8_t opcode,
                                       uint8_t payload_len, uint16_t *frame_len);
+/* Writes header and CRC around the payload_len bytes at frame + ARACHNAE_FRAME_PAYLOAD, sets
+ * *frame_len, returns OK; the caller checked that ARACHNAE_FRAME_OVERHEAD + payload_len bytes fit.
+ * (Argument order as the generated _build functions', so that they end in a jump here.) */
+arachnae_status arachnae_frame_seal(uint8_t opcode, uint8_t dst, uint8_t src, uint8_t *frame, uint8_t payload_len,
+                                    uint16_t *frame_len);
 /* Envelope check: TRUNCATED/OVERSIZE, CHECKSUM, then ADDRESS (own = ARACHNAE_ANY_ADDRESS skips it). */
 arachnae_status arachnae_frame_check(const uint8_t *frame, uint16_t len, uint16_t own);
 
@@ -459,7 +470,16 @@ typedef struct {
 } arachnae_unhandled;
 
 /* Records `st` for `opcode` when it is not OK; returns st. */
-arachnae_status arachnae_unhandled_note(arachnae_unhandled *u, uint8_t opcode, arachnae_status st);
+static inline arachnae_status arachnae_unhandled_note(arachnae_unhandled *u, uint8_t opcode, arachnae_status st)
+{
+    if (st != ARACHNAE_OK) {
+        if (u->count != 0xFFFFu)
+            u->count++;
+        u->opcode = opcode;
+        u->status = (uint8_t)st;
+    }
+    return st;
+}
 
 /* ---- byte-at-a-time parser (UART RX interrupt) ----
  * feed() returns ARACHNAE_NONE while a frame is incomplete, ARACHNAE_OK when a
@@ -471,17 +491,15 @@ arachnae_status arachnae_unhandled_note(arachnae_unhandled *u, uint8_t opcode, a
  * than its length byte said: feed() then reports OVERSIZE, which supersedes the
  * earlier verdict for that frame. gap() (idle-gap timer) reports TRUNCATED for a
  * frame cut short and re-arms the parser. Call feed() and gap() from contexts
- * that do not preempt each other. The CRC runs one byte per feed(), so an ISR
- * never loops over a whole frame. */
+ * that do not preempt each other. The CRC runs once, over the whole frame, in the
+ * feed() of its last byte: the bus is quiet for the idle gap after it. */
 typedef arachnae_status (*arachnae_payload_check_fn)(uint8_t opcode, const uint8_t *payload, uint8_t len);
 
 typedef struct {
     uint8_t *buf;
     uint16_t cap;
     uint16_t count;
-    uint16_t expected;  /* whole frame size once the length byte arrived, else 0 */
     uint16_t own;
-    uint16_t crc;
     uint8_t state;
     arachnae_payload_check_fn check;  /* OPCODE/LENGTH/RANGE, NULL: envelope only */
 } arachnae_parser;
@@ -517,6 +535,8 @@ typedef struct {
 
 arachnae_status arachnae_id_ack_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_id_ack_decode(const uint8_t *payload, uint8_t len, arachnae_id_ack_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_id_ack_unpack(const uint8_t *payload, uint8_t len, arachnae_id_ack_t *out);
 arachnae_status arachnae_id_ack_check(const arachnae_id_ack_t *m);
 arachnae_status arachnae_id_ack_encode(const arachnae_id_ack_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_id_ack_build(const arachnae_id_ack_t *m, uint8_t dst, uint8_t src,
@@ -533,6 +553,8 @@ typedef struct {
 
 arachnae_status arachnae_status_ack_busy_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_status_ack_busy_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_busy_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_status_ack_busy_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_busy_t *out);
 arachnae_status arachnae_status_ack_busy_check(const arachnae_status_ack_busy_t *m);
 arachnae_status arachnae_status_ack_busy_encode(const arachnae_status_ack_busy_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_status_ack_busy_build(const arachnae_status_ack_busy_t *m, uint8_t dst, uint8_t src,
@@ -545,6 +567,8 @@ typedef struct {
 
 arachnae_status arachnae_status_ack_order_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_status_ack_order_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_order_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_status_ack_order_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_order_t *out);
 arachnae_status arachnae_status_ack_order_check(const arachnae_status_ack_order_t *m);
 arachnae_status arachnae_status_ack_order_encode(const arachnae_status_ack_order_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_status_ack_order_build(const arachnae_status_ack_order_t *m, uint8_t dst, uint8_t src,
@@ -557,6 +581,8 @@ typedef struct {
 
 arachnae_status arachnae_status_ack_range_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_status_ack_range_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_range_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_status_ack_range_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_range_t *out);
 arachnae_status arachnae_status_ack_range_check(const arachnae_status_ack_range_t *m);
 arachnae_status arachnae_status_ack_range_encode(const arachnae_status_ack_range_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_status_ack_range_build(const arachnae_status_ack_range_t *m, uint8_t dst, uint8_t src,
@@ -572,6 +598,8 @@ typedef struct {
 
 arachnae_status arachnae_status_ack_mmc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_status_ack_mmc_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_mmc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_status_ack_mmc_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_mmc_t *out);
 arachnae_status arachnae_status_ack_mmc_check(const arachnae_status_ack_mmc_t *m);
 arachnae_status arachnae_status_ack_mmc_encode(const arachnae_status_ack_mmc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_status_ack_mmc_build(const arachnae_status_ack_mmc_t *m, uint8_t dst, uint8_t src,
@@ -589,6 +617,8 @@ typedef struct {
 
 arachnae_status arachnae_post_report_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_post_report_decode(const uint8_t *payload, uint8_t len, arachnae_post_report_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_post_report_unpack(const uint8_t *payload, uint8_t len, arachnae_post_report_t *out);
 arachnae_status arachnae_post_report_check(const arachnae_post_report_t *m);
 arachnae_status arachnae_post_report_encode(const arachnae_post_report_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_post_report_build(const arachnae_post_report_t *m, uint8_t dst, uint8_t src,
@@ -617,6 +647,8 @@ typedef struct {
 
 arachnae_status arachnae_xmit_record_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_record_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_record_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_xmit_record_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_record_t *out);
 arachnae_status arachnae_xmit_record_check(const arachnae_xmit_record_t *m);
 arachnae_status arachnae_xmit_record_encode(const arachnae_xmit_record_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_record_build(const arachnae_xmit_record_t *m, uint8_t dst, uint8_t src,
@@ -632,6 +664,8 @@ typedef struct {
 
 arachnae_status arachnae_data_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_data_decode(const uint8_t *payload, uint8_t len, arachnae_data_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_data_unpack(const uint8_t *payload, uint8_t len, arachnae_data_t *out);
 arachnae_status arachnae_data_check(const arachnae_data_t *m);
 arachnae_status arachnae_data_encode(const arachnae_data_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_data_build(const arachnae_data_t *m, uint8_t dst, uint8_t src,
@@ -645,6 +679,8 @@ typedef struct {
 
 arachnae_status arachnae_move_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_move_decode(const uint8_t *payload, uint8_t len, arachnae_move_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_move_unpack(const uint8_t *payload, uint8_t len, arachnae_move_t *out);
 arachnae_status arachnae_move_check(const arachnae_move_t *m);
 arachnae_status arachnae_move_encode(const arachnae_move_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_move_build(const arachnae_move_t *m, uint8_t dst, uint8_t src,
@@ -659,6 +695,8 @@ typedef struct {
 
 arachnae_status arachnae_move_relayed_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_move_relayed_decode(const uint8_t *payload, uint8_t len, arachnae_move_relayed_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_move_relayed_unpack(const uint8_t *payload, uint8_t len, arachnae_move_relayed_t *out);
 arachnae_status arachnae_move_relayed_check(const arachnae_move_relayed_t *m);
 arachnae_status arachnae_move_relayed_encode(const arachnae_move_relayed_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_move_relayed_build(const arachnae_move_relayed_t *m, uint8_t dst, uint8_t src,
@@ -675,6 +713,8 @@ typedef struct {
 
 arachnae_status arachnae_setup_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_setup_decode(const uint8_t *payload, uint8_t len, arachnae_setup_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_setup_unpack(const uint8_t *payload, uint8_t len, arachnae_setup_t *out);
 arachnae_status arachnae_setup_check(const arachnae_setup_t *m);
 arachnae_status arachnae_setup_encode(const arachnae_setup_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_setup_build(const arachnae_setup_t *m, uint8_t dst, uint8_t src,
@@ -689,6 +729,8 @@ typedef struct {
 
 arachnae_status arachnae_speak_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_speak_decode(const uint8_t *payload, uint8_t len, arachnae_speak_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_speak_unpack(const uint8_t *payload, uint8_t len, arachnae_speak_t *out);
 arachnae_status arachnae_speak_check(const arachnae_speak_t *m);
 arachnae_status arachnae_speak_encode(const arachnae_speak_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_speak_build(const arachnae_speak_t *m, uint8_t dst, uint8_t src,
@@ -703,6 +745,8 @@ typedef struct {
 
 arachnae_status arachnae_speak_resident_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_speak_resident_decode(const uint8_t *payload, uint8_t len, arachnae_speak_resident_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_speak_resident_unpack(const uint8_t *payload, uint8_t len, arachnae_speak_resident_t *out);
 arachnae_status arachnae_speak_resident_check(const arachnae_speak_resident_t *m);
 arachnae_status arachnae_speak_resident_encode(const arachnae_speak_resident_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_speak_resident_build(const arachnae_speak_resident_t *m, uint8_t dst, uint8_t src,
@@ -717,6 +761,8 @@ typedef struct {
 
 arachnae_status arachnae_lcd_text_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_lcd_text_decode(const uint8_t *payload, uint8_t len, arachnae_lcd_text_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_lcd_text_unpack(const uint8_t *payload, uint8_t len, arachnae_lcd_text_t *out);
 arachnae_status arachnae_lcd_text_check(const arachnae_lcd_text_t *m);
 arachnae_status arachnae_lcd_text_encode(const arachnae_lcd_text_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_lcd_text_build(const arachnae_lcd_text_t *m, uint8_t dst, uint8_t src,
@@ -729,6 +775,8 @@ typedef struct {
 
 arachnae_status arachnae_uic_alert_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_uic_alert_decode(const uint8_t *payload, uint8_t len, arachnae_uic_alert_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_uic_alert_unpack(const uint8_t *payload, uint8_t len, arachnae_uic_alert_t *out);
 arachnae_status arachnae_uic_alert_check(const arachnae_uic_alert_t *m);
 arachnae_status arachnae_uic_alert_encode(const arachnae_uic_alert_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_uic_alert_build(const arachnae_uic_alert_t *m, uint8_t dst, uint8_t src,
@@ -741,6 +789,8 @@ typedef struct {
 
 arachnae_status arachnae_head_set_abs_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_head_set_abs_decode(const uint8_t *payload, uint8_t len, arachnae_head_set_abs_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_head_set_abs_unpack(const uint8_t *payload, uint8_t len, arachnae_head_set_abs_t *out);
 arachnae_status arachnae_head_set_abs_check(const arachnae_head_set_abs_t *m);
 arachnae_status arachnae_head_set_abs_encode(const arachnae_head_set_abs_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_head_set_abs_build(const arachnae_head_set_abs_t *m, uint8_t dst, uint8_t src,
@@ -753,6 +803,8 @@ typedef struct {
 
 arachnae_status arachnae_head_set_rel_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_head_set_rel_decode(const uint8_t *payload, uint8_t len, arachnae_head_set_rel_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_head_set_rel_unpack(const uint8_t *payload, uint8_t len, arachnae_head_set_rel_t *out);
 arachnae_status arachnae_head_set_rel_check(const arachnae_head_set_rel_t *m);
 arachnae_status arachnae_head_set_rel_encode(const arachnae_head_set_rel_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_head_set_rel_build(const arachnae_head_set_rel_t *m, uint8_t dst, uint8_t src,
@@ -798,6 +850,8 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_usrc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_usrc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_usrc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_xmit_data_usrc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_usrc_t *out);
 arachnae_status arachnae_xmit_data_usrc_check(const arachnae_xmit_data_usrc_t *m);
 arachnae_status arachnae_xmit_data_usrc_encode(const arachnae_xmit_data_usrc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_usrc_build(const arachnae_xmit_data_usrc_t *m, uint8_t dst, uint8_t src,
@@ -813,6 +867,8 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_tpsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_tpsc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_tpsc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_xmit_data_tpsc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_tpsc_t *out);
 arachnae_status arachnae_xmit_data_tpsc_check(const arachnae_xmit_data_tpsc_t *m);
 arachnae_status arachnae_xmit_data_tpsc_encode(const arachnae_xmit_data_tpsc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_tpsc_build(const arachnae_xmit_data_tpsc_t *m, uint8_t dst, uint8_t src,
@@ -827,6 +883,8 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_irrc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_irrc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_irrc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_xmit_data_irrc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_irrc_t *out);
 arachnae_status arachnae_xmit_data_irrc_check(const arachnae_xmit_data_irrc_t *m);
 arachnae_status arachnae_xmit_data_irrc_encode(const arachnae_xmit_data_irrc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_irrc_build(const arachnae_xmit_data_irrc_t *m, uint8_t dst, uint8_t src,
@@ -849,6 +907,8 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_isc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_isc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_isc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_xmit_data_isc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_isc_t *out);
 arachnae_status arachnae_xmit_data_isc_check(const arachnae_xmit_data_isc_t *m);
 arachnae_status arachnae_xmit_data_isc_encode(const arachnae_xmit_data_isc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_isc_build(const arachnae_xmit_data_isc_t *m, uint8_t dst, uint8_t src,
@@ -862,6 +922,8 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_tsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_tsc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_tsc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_xmit_data_tsc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_tsc_t *out);
 arachnae_status arachnae_xmit_data_tsc_check(const arachnae_xmit_data_tsc_t *m);
 arachnae_status arachnae_xmit_data_tsc_encode(const arachnae_xmit_data_tsc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_tsc_build(const arachnae_xmit_data_tsc_t *m, uint8_t dst, uint8_t src,
@@ -874,6 +936,8 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_lsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_lsc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_lsc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_xmit_data_lsc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_lsc_t *out);
 arachnae_status arachnae_xmit_data_lsc_check(const arachnae_xmit_data_lsc_t *m);
 arachnae_status arachnae_xmit_data_lsc_encode(const arachnae_xmit_data_lsc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_lsc_build(const arachnae_xmit_data_lsc_t *m, uint8_t dst, uint8_t src,
@@ -889,6 +953,8 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_psc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_psc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_psc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_xmit_data_psc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_psc_t *out);
 arachnae_status arachnae_xmit_data_psc_check(const arachnae_xmit_data_psc_t *m);
 arachnae_status arachnae_xmit_data_psc_encode(const arachnae_xmit_data_psc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_psc_build(const arachnae_xmit_data_psc_t *m, uint8_t dst, uint8_t src,
@@ -904,6 +970,8 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_irrc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_irrc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_irrc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_set_alarm_irrc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_irrc_t *out);
 arachnae_status arachnae_set_alarm_irrc_check(const arachnae_set_alarm_irrc_t *m);
 arachnae_status arachnae_set_alarm_irrc_encode(const arachnae_set_alarm_irrc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_set_alarm_irrc_build(const arachnae_set_alarm_irrc_t *m, uint8_t dst, uint8_t src,
@@ -920,6 +988,8 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_isc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_isc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_isc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_set_alarm_isc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_isc_t *out);
 arachnae_status arachnae_set_alarm_isc_check(const arachnae_set_alarm_isc_t *m);
 arachnae_status arachnae_set_alarm_isc_encode(const arachnae_set_alarm_isc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_set_alarm_isc_build(const arachnae_set_alarm_isc_t *m, uint8_t dst, uint8_t src,
@@ -933,6 +1003,8 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_tsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_tsc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_tsc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_set_alarm_tsc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_tsc_t *out);
 arachnae_status arachnae_set_alarm_tsc_check(const arachnae_set_alarm_tsc_t *m);
 arachnae_status arachnae_set_alarm_tsc_encode(const arachnae_set_alarm_tsc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_set_alarm_tsc_build(const arachnae_set_alarm_tsc_t *m, uint8_t dst, uint8_t src,
@@ -945,6 +1017,8 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_lsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_lsc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_lsc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_set_alarm_lsc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_lsc_t *out);
 arachnae_status arachnae_set_alarm_lsc_check(const arachnae_set_alarm_lsc_t *m);
 arachnae_status arachnae_set_alarm_lsc_encode(const arachnae_set_alarm_lsc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_set_alarm_lsc_build(const arachnae_set_alarm_lsc_t *m, uint8_t dst, uint8_t src,
@@ -960,6 +1034,8 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_psc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_psc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_psc_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_set_alarm_psc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_psc_t *out);
 arachnae_status arachnae_set_alarm_psc_check(const arachnae_set_alarm_psc_t *m);
 arachnae_status arachnae_set_alarm_psc_encode(const arachnae_set_alarm_psc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_set_alarm_psc_build(const arachnae_set_alarm_psc_t *m, uint8_t dst, uint8_t src,
@@ -979,6 +1055,8 @@ typedef struct {
 
 arachnae_status arachnae_leg_target_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_leg_target_decode(const uint8_t *payload, uint8_t len, arachnae_leg_target_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_leg_target_unpack(const uint8_t *payload, uint8_t len, arachnae_leg_target_t *out);
 arachnae_status arachnae_leg_target_check(const arachnae_leg_target_t *m);
 arachnae_status arachnae_leg_target_encode(const arachnae_leg_target_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_leg_target_build(const arachnae_leg_target_t *m, uint8_t dst, uint8_t src,
@@ -1008,6 +1086,8 @@ typedef struct {
 
 arachnae_status arachnae_leg_report_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_leg_report_decode(const uint8_t *payload, uint8_t len, arachnae_leg_report_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_leg_report_unpack(const uint8_t *payload, uint8_t len, arachnae_leg_report_t *out);
 arachnae_status arachnae_leg_report_check(const arachnae_leg_report_t *m);
 arachnae_status arachnae_leg_report_encode(const arachnae_leg_report_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_leg_report_build(const arachnae_leg_report_t *m, uint8_t dst, uint8_t src,
@@ -1030,6 +1110,8 @@ typedef struct {
 
 arachnae_status arachnae_joint_target_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_joint_target_decode(const uint8_t *payload, uint8_t len, arachnae_joint_target_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_joint_target_unpack(const uint8_t *payload, uint8_t len, arachnae_joint_target_t *out);
 arachnae_status arachnae_joint_target_check(const arachnae_joint_target_t *m);
 arachnae_status arachnae_joint_target_encode(const arachnae_joint_target_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_joint_target_build(const arachnae_joint_target_t *m, uint8_t dst, uint8_t src,
@@ -1056,6 +1138,8 @@ typedef struct {
 
 arachnae_status arachnae_joint_feedback_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_joint_feedback_decode(const uint8_t *payload, uint8_t len, arachnae_joint_feedback_t *out);
+/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+void arachnae_joint_feedback_unpack(const uint8_t *payload, uint8_t len, arachnae_joint_feedback_t *out);
 arachnae_status arachnae_joint_feedback_check(const arachnae_joint_feedback_t *m);
 arachnae_status arachnae_joint_feedback_encode(const arachnae_joint_feedback_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_joint_feedback_build(const arachnae_joint_feedback_t *m, uint8_t dst, uint8_t src,

@@ -6,10 +6,14 @@
 typedef char arachnae_spec_hash_ok[(ARACHNAE_SPEC_HASH == 0xE31C9693UL) ? 1 : -1];
 
 /* CRC-16/IBM-3740, poly 0x1021, MSB first. No table: a 256-entry table is 512 bytes
- * of flash that avr-gcc would also copy to RAM unless placed in PROGMEM. The default
- * is the shift/xor form of the 0x1021 byte step (about 10 operations a byte, no loop);
- * -DARACHNAE_CRC_BITWISE selects the plain 8-step loop, the smallest code. */
-uint16_t arachnae_crc16_update(uint16_t crc, uint8_t byte)
+ * of flash that avr-gcc would also copy to RAM unless placed in PROGMEM. Elsewhere the default
+ * is the shift/xor form of the 0x1021 byte step (about 10 operations a byte, no loop); on AVR,
+ * or with -DARACHNAE_CRC_BITWISE, the plain 8-step loop, the smallest code (34 against 60
+ * bytes on an ATmega328P, issue 15; a few microseconds a byte at 16 MHz). */
+#if defined(__AVR__) && !defined(ARACHNAE_CRC_BITWISE)
+#define ARACHNAE_CRC_BITWISE
+#endif
+static inline uint16_t crc_step(uint16_t crc, uint8_t byte)
 {
 #ifdef ARACHNAE_CRC_BITWISE
     uint8_t i;
@@ -27,67 +31,50 @@ uint16_t arachnae_crc16_update(uint16_t crc, uint8_t byte)
 #endif
 }
 
+uint16_t arachnae_crc16_update(uint16_t crc, uint8_t byte)
+{
+    return crc_step(crc, byte);
+}
+
+/* the step inlined: a node that only checks and seals frames links this function alone */
 uint16_t arachnae_crc16(const uint8_t *data, uint16_t len)
 {
     uint16_t crc = ARACHNAE_CRC_INIT;
     uint16_t i;
     for (i = 0; i < len; i++)
-        crc = arachnae_crc16_update(crc, data[i]);
+        crc = crc_step(crc, data[i]);
     return (uint16_t)(crc ^ ARACHNAE_CRC_XOROUT);
 }
 
-void arachnae_frame_header(const uint8_t *frame, arachnae_header *h)
+arachnae_status arachnae_frame_seal(uint8_t opcode, uint8_t dst, uint8_t src, uint8_t *frame, uint8_t payload_len,
+                                    uint16_t *frame_len)
 {
-    h->dst = frame[ARACHNAE_FRAME_DST];
-    h->src = frame[ARACHNAE_FRAME_SRC];
-    h->opcode = frame[ARACHNAE_FRAME_OPCODE];
-    h->length = frame[ARACHNAE_FRAME_LENGTH];
+    uint16_t n = (uint16_t)(ARACHNAE_FRAME_HEADER_SIZE + payload_len);
+    uint16_t crc;
+    frame[ARACHNAE_FRAME_DST] = dst;
+    frame[ARACHNAE_FRAME_SRC] = src;
+    frame[ARACHNAE_FRAME_OPCODE] = opcode;
+    frame[ARACHNAE_FRAME_LENGTH] = payload_len;
+    crc = arachnae_crc16(frame, n);
+    /* the CRC travels big-endian after the payload (spec frame.byte_order) */
+    frame[n] = (uint8_t)(crc >> 8);
+    frame[n + 1u] = (uint8_t)(crc & 0xFFu);
+    *frame_len = (uint16_t)(n + ARACHNAE_FRAME_CRC_SIZE);
+    return ARACHNAE_OK;
 }
 
 arachnae_status arachnae_frame_finish(uint8_t *frame, uint16_t cap, uint8_t dst, uint8_t src, uint8_t opcode,
                                       uint8_t payload_len, uint16_t *frame_len)
 {
-    uint16_t n = (uint16_t)(ARACHNAE_FRAME_OVERHEAD + payload_len);
-    uint16_t crc;
-    if (cap < n)
+    if (cap < (uint16_t)(ARACHNAE_FRAME_OVERHEAD + payload_len))
         return ARACHNAE_BUFFER;
-    frame[ARACHNAE_FRAME_DST] = dst;
-    frame[ARACHNAE_FRAME_SRC] = src;
-    frame[ARACHNAE_FRAME_OPCODE] = opcode;
-    frame[ARACHNAE_FRAME_LENGTH] = payload_len;
-    crc = arachnae_crc16(frame, (uint16_t)(n - ARACHNAE_FRAME_CRC_SIZE));
-    /* the CRC travels big-endian after the payload (spec frame.byte_order) */
-    frame[n - 2u] = (uint8_t)(crc >> 8);
-    frame[n - 1u] = (uint8_t)(crc & 0xFFu);
-    *frame_len = n;
-    return ARACHNAE_OK;
-}
-
-arachnae_status arachnae_unhandled_note(arachnae_unhandled *u, uint8_t opcode, arachnae_status st)
-{
-    if (st != ARACHNAE_OK) {
-        if (u->count != 0xFFFFu)
-            u->count++;
-        u->opcode = opcode;
-        u->status = (uint8_t)st;
-    }
-    return st;
-}
-
-static arachnae_status crc_and_address(const uint8_t *frame, uint16_t len, uint16_t crc, uint16_t own)
-{
-    uint16_t got = (uint16_t)(((unsigned)frame[len - 2u] << 8) | (unsigned)frame[len - 1u]);
-    uint8_t dst = frame[ARACHNAE_FRAME_DST];
-    if (crc != got)
-        return ARACHNAE_CHECKSUM;
-    if (own != ARACHNAE_ANY_ADDRESS && dst != own && dst != ARACHNAE_ADDR_BROADCAST)
-        return ARACHNAE_ADDRESS;
-    return ARACHNAE_OK;
+    return arachnae_frame_seal(opcode, dst, src, frame, payload_len, frame_len);
 }
 
 arachnae_status arachnae_frame_check(const uint8_t *frame, uint16_t len, uint16_t own)
 {
     uint16_t need;
+    uint8_t dst;
     if (len < ARACHNAE_FRAME_OVERHEAD)
         return ARACHNAE_TRUNCATED;
     need = (uint16_t)(ARACHNAE_FRAME_OVERHEAD + frame[ARACHNAE_FRAME_LENGTH]);
@@ -95,7 +82,13 @@ arachnae_status arachnae_frame_check(const uint8_t *frame, uint16_t len, uint16_
         return ARACHNAE_TRUNCATED;
     if (len > need)
         return ARACHNAE_OVERSIZE;
-    return crc_and_address(frame, len, arachnae_crc16(frame, (uint16_t)(len - ARACHNAE_FRAME_CRC_SIZE)), own);
+    /* MSB-first CRC without xorout: over a good frame with its big-endian CRC it gives 0 */
+    if (arachnae_crc16(frame, len) != 0u)
+        return ARACHNAE_CHECKSUM;
+    dst = frame[ARACHNAE_FRAME_DST];
+    if (own != ARACHNAE_ANY_ADDRESS && dst != own && dst != ARACHNAE_ADDR_BROADCAST)
+        return ARACHNAE_ADDRESS;
+    return ARACHNAE_OK;
 }
 
 /* parser states */
@@ -113,51 +106,47 @@ void arachnae_parser_init(arachnae_parser *p, uint8_t *buf, uint16_t cap, uint16
     p->own = own;
     p->check = check;
     p->count = 0;
-    p->expected = 0;
-    p->crc = ARACHNAE_CRC_INIT;
     p->state = PS_RECEIVING;
-}
-
-static arachnae_status verdict(arachnae_parser *p)
-{
-    arachnae_status st = crc_and_address(p->buf, p->count, (uint16_t)(p->crc ^ ARACHNAE_CRC_XOROUT), p->own);
-    if (st == ARACHNAE_OK && p->check != 0)
-        st = p->check(p->buf[ARACHNAE_FRAME_OPCODE], p->buf + ARACHNAE_FRAME_PAYLOAD, p->buf[ARACHNAE_FRAME_LENGTH]);
-    p->state = (st == ARACHNAE_OK) ? PS_READY : PS_COMPLETE;
-    return st;
 }
 
 arachnae_status arachnae_parser_feed(arachnae_parser *p, uint8_t byte)
 {
-    if (p->state == PS_COMPLETE || p->state == PS_READY) {
-        /* more bytes than the length byte said */
-        p->state = PS_DISCARD;
-        return ARACHNAE_OVERSIZE;
-    }
-    if (p->state == PS_DISCARD)
-        return ARACHNAE_NONE;
-    if (p->state == PS_HELD) {
-        p->state = PS_RECEIVING;
-        p->count = 0;
-    }
-    if (p->count >= p->cap) {
-        p->state = PS_DISCARD;
-        return ARACHNAE_OVERSIZE;
-    }
-    p->buf[p->count] = byte;
-    p->count++;
-    if (p->expected == 0u || p->count <= (uint16_t)(p->expected - ARACHNAE_FRAME_CRC_SIZE))
-        p->crc = arachnae_crc16_update(p->crc, byte);
-    if (p->count == ARACHNAE_FRAME_LENGTH + 1u) {
-        p->expected = (uint16_t)(ARACHNAE_FRAME_OVERHEAD + byte);
-        if (p->expected > p->cap) {
+    uint16_t n, need;
+    arachnae_status st;
+    if (p->state != PS_RECEIVING) {
+        if (p->state == PS_DISCARD)
+            return ARACHNAE_NONE;
+        if (p->state != PS_HELD) {
+            /* COMPLETE or READY: more bytes than the length byte said */
             p->state = PS_DISCARD;
             return ARACHNAE_OVERSIZE;
         }
+        p->state = PS_RECEIVING;
+        p->count = 0;
     }
-    if (p->count >= ARACHNAE_FRAME_OVERHEAD && p->count == p->expected)
-        return verdict(p);
-    return ARACHNAE_NONE;
+    n = p->count;
+    if (n >= p->cap) {
+        p->state = PS_DISCARD;
+        return ARACHNAE_OVERSIZE;
+    }
+    p->buf[n] = byte;
+    p->count = ++n;
+    if (n <= ARACHNAE_FRAME_LENGTH)
+        return ARACHNAE_NONE;
+    need = (uint16_t)(ARACHNAE_FRAME_OVERHEAD + p->buf[ARACHNAE_FRAME_LENGTH]);
+    if (need > p->cap) {  /* known as soon as the length byte is in */
+        p->state = PS_DISCARD;
+        return ARACHNAE_OVERSIZE;
+    }
+    if (n != need)
+        return ARACHNAE_NONE;
+    /* The whole frame is in: the CRC runs over it here, once. The next byte of the bus
+     * comes only after the idle gap, so this loop (6 to 261 bytes) delays no byte. */
+    st = arachnae_frame_check(p->buf, n, p->own);
+    if (st == ARACHNAE_OK && p->check != 0)
+        st = p->check(p->buf[ARACHNAE_FRAME_OPCODE], p->buf + ARACHNAE_FRAME_PAYLOAD, p->buf[ARACHNAE_FRAME_LENGTH]);
+    p->state = (st == ARACHNAE_OK) ? PS_READY : PS_COMPLETE;
+    return st;
 }
 
 arachnae_status arachnae_parser_gap(arachnae_parser *p)
@@ -169,8 +158,6 @@ arachnae_status arachnae_parser_gap(arachnae_parser *p)
         p->state = PS_RECEIVING;
         p->count = 0;
     }
-    p->expected = 0;
-    p->crc = ARACHNAE_CRC_INIT;
     return st;
 }
 

@@ -28,19 +28,25 @@ arachnae_status arachnae_data_validate(const uint8_t *payload, uint8_t len)
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_data_decode(const uint8_t *payload, uint8_t len, arachnae_data_t *out)
+void arachnae_data_unpack(const uint8_t *payload, uint8_t len, arachnae_data_t *out)
 {
-    arachnae_status st = arachnae_data_validate(payload, len);
-    if (st != ARACHNAE_OK)
-        return st;
+    (void)len;
     out->address = (uint8_t)((unsigned)payload[0]);
     out->kind = (uint8_t)((unsigned)payload[1]);
     out->channel = (uint16_t)(((unsigned)payload[2] << 8) | (unsigned)payload[3]);
     out->value = (uint8_t)((unsigned)payload[4]);
-    return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_data_check(const arachnae_data_t *m)
+arachnae_status arachnae_data_decode(const uint8_t *payload, uint8_t len, arachnae_data_t *out)
+{
+    arachnae_status st = arachnae_data_validate(payload, len);
+    if (st == ARACHNAE_OK)
+        arachnae_data_unpack(payload, len, out);
+    return st;
+}
+
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
+static inline arachnae_status check(const arachnae_data_t *m)
 {
     if (!(arachnae_is_node(m->address)))
         return ARACHNAE_RANGE;
@@ -51,31 +57,40 @@ arachnae_status arachnae_data_check(const arachnae_data_t *m)
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_data_encode(const arachnae_data_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+arachnae_status arachnae_data_check(const arachnae_data_t *m)
 {
-    arachnae_status st = arachnae_data_check(m);
-    uint16_t n;
-    if (st != ARACHNAE_OK)
-        return st;
-    n = 5u;
-    if (cap < n)
-        return ARACHNAE_BUFFER;
+    return check(m);
+}
+
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
+static uint8_t pack(const arachnae_data_t *m, uint8_t *payload)
+{
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->address & 0xFFu));
     payload[1] = (uint8_t)(((unsigned)(uint16_t)m->kind & 0xFFu));
     payload[2] = (uint8_t)((((unsigned)(uint16_t)m->channel >> 8) & 0xFFu));
     payload[3] = (uint8_t)(((unsigned)(uint16_t)m->channel & 0xFFu));
     payload[4] = (uint8_t)(((unsigned)(uint16_t)m->value & 0xFFu));
-    *len = (uint8_t)n;
+    return 5u;
+}
+
+arachnae_status arachnae_data_encode(const arachnae_data_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+{
+    arachnae_status st = check(m);
+    if (st != ARACHNAE_OK)
+        return st;
+    if (cap < 5u)
+        return ARACHNAE_BUFFER;
+    *len = pack(m, payload);
     return ARACHNAE_OK;
 }
 
 arachnae_status arachnae_data_build(const arachnae_data_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len)
 {
-    uint8_t len = 0;
-    uint16_t room = (cap > ARACHNAE_FRAME_OVERHEAD) ? (uint16_t)(cap - ARACHNAE_FRAME_OVERHEAD) : 0u;
-    arachnae_status st = arachnae_data_encode(m, frame + ARACHNAE_FRAME_PAYLOAD, room, &len);
+    arachnae_status st = check(m);
     if (st != ARACHNAE_OK)
         return st;
-    return arachnae_frame_finish(frame, cap, dst, src, ARACHNAE_OP_DATA, len, frame_len);
+    if (cap < ARACHNAE_FRAME_OVERHEAD + 5u)
+        return ARACHNAE_BUFFER;
+    return arachnae_frame_seal(ARACHNAE_OP_DATA, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

@@ -18,44 +18,59 @@ arachnae_status arachnae_head_set_rel_validate(const uint8_t *payload, uint8_t l
     return ARACHNAE_OK;
 }
 
+void arachnae_head_set_rel_unpack(const uint8_t *payload, uint8_t len, arachnae_head_set_rel_t *out)
+{
+    (void)len;
+    out->angle = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[0] << 8) | (unsigned)payload[1]), 0x8000u, 0xFFFFu);
+}
+
 arachnae_status arachnae_head_set_rel_decode(const uint8_t *payload, uint8_t len, arachnae_head_set_rel_t *out)
 {
     arachnae_status st = arachnae_head_set_rel_validate(payload, len);
-    if (st != ARACHNAE_OK)
-        return st;
-    out->angle = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[0] << 8) | (unsigned)payload[1]), 0x8000u, 0xFFFFu);
-    return ARACHNAE_OK;
+    if (st == ARACHNAE_OK)
+        arachnae_head_set_rel_unpack(payload, len, out);
+    return st;
 }
 
-arachnae_status arachnae_head_set_rel_check(const arachnae_head_set_rel_t *m)
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
+static inline arachnae_status check(const arachnae_head_set_rel_t *m)
 {
     if (!(m->angle >= -359 && m->angle <= 359))
         return ARACHNAE_RANGE;
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_head_set_rel_encode(const arachnae_head_set_rel_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+arachnae_status arachnae_head_set_rel_check(const arachnae_head_set_rel_t *m)
 {
-    arachnae_status st = arachnae_head_set_rel_check(m);
-    uint16_t n;
-    if (st != ARACHNAE_OK)
-        return st;
-    n = 2u;
-    if (cap < n)
-        return ARACHNAE_BUFFER;
+    return check(m);
+}
+
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
+static uint8_t pack(const arachnae_head_set_rel_t *m, uint8_t *payload)
+{
     payload[0] = (uint8_t)((((unsigned)(uint16_t)m->angle >> 8) & 0xFFu));
     payload[1] = (uint8_t)(((unsigned)(uint16_t)m->angle & 0xFFu));
-    *len = (uint8_t)n;
+    return 2u;
+}
+
+arachnae_status arachnae_head_set_rel_encode(const arachnae_head_set_rel_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+{
+    arachnae_status st = check(m);
+    if (st != ARACHNAE_OK)
+        return st;
+    if (cap < 2u)
+        return ARACHNAE_BUFFER;
+    *len = pack(m, payload);
     return ARACHNAE_OK;
 }
 
 arachnae_status arachnae_head_set_rel_build(const arachnae_head_set_rel_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len)
 {
-    uint8_t len = 0;
-    uint16_t room = (cap > ARACHNAE_FRAME_OVERHEAD) ? (uint16_t)(cap - ARACHNAE_FRAME_OVERHEAD) : 0u;
-    arachnae_status st = arachnae_head_set_rel_encode(m, frame + ARACHNAE_FRAME_PAYLOAD, room, &len);
+    arachnae_status st = check(m);
     if (st != ARACHNAE_OK)
         return st;
-    return arachnae_frame_finish(frame, cap, dst, src, ARACHNAE_OP_HEAD_SET_REL, len, frame_len);
+    if (cap < ARACHNAE_FRAME_OVERHEAD + 2u)
+        return ARACHNAE_BUFFER;
+    return arachnae_frame_seal(ARACHNAE_OP_HEAD_SET_REL, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

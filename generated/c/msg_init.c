@@ -13,5 +13,7 @@ arachnae_status arachnae_init_validate(const uint8_t *payload, uint8_t len)
 
 arachnae_status arachnae_init_build(uint8_t dst, uint8_t src, uint8_t *frame, uint16_t cap, uint16_t *frame_len)
 {
-    return arachnae_frame_finish(frame, cap, dst, src, ARACHNAE_OP_INIT, 0u, frame_len);
+    if (cap < ARACHNAE_FRAME_OVERHEAD)
+        return ARACHNAE_BUFFER;
+    return arachnae_frame_seal(ARACHNAE_OP_INIT, dst, src, frame, 0u, frame_len);
 }

@@ -38,20 +38,26 @@ arachnae_status arachnae_joint_feedback_validate(const uint8_t *payload, uint8_t
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_joint_feedback_decode(const uint8_t *payload, uint8_t len, arachnae_joint_feedback_t *out)
+void arachnae_joint_feedback_unpack(const uint8_t *payload, uint8_t len, arachnae_joint_feedback_t *out)
 {
-    arachnae_status st = arachnae_joint_feedback_validate(payload, len);
-    if (st != ARACHNAE_OK)
-        return st;
+    (void)len;
     out->angle = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[0] << 8) | (unsigned)payload[1]), 0x8000u, 0xFFFFu);
     out->speed = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[2] << 8) | (unsigned)payload[3]), 0x8000u, 0xFFFFu);
     out->current = (uint16_t)(((unsigned)payload[4] << 8) | (unsigned)payload[5]);
     out->temperature = (int8_t)arachnae_sext((uint16_t)((unsigned)payload[6]), 0x80u, 0xFFu);
     out->flags = (uint8_t)((unsigned)payload[7]);
-    return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_joint_feedback_check(const arachnae_joint_feedback_t *m)
+arachnae_status arachnae_joint_feedback_decode(const uint8_t *payload, uint8_t len, arachnae_joint_feedback_t *out)
+{
+    arachnae_status st = arachnae_joint_feedback_validate(payload, len);
+    if (st == ARACHNAE_OK)
+        arachnae_joint_feedback_unpack(payload, len, out);
+    return st;
+}
+
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
+static inline arachnae_status check(const arachnae_joint_feedback_t *m)
 {
     if (!(m->angle >= -1800 && m->angle <= 1800))
         return ARACHNAE_RANGE;
@@ -66,15 +72,14 @@ arachnae_status arachnae_joint_feedback_check(const arachnae_joint_feedback_t *m
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_joint_feedback_encode(const arachnae_joint_feedback_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+arachnae_status arachnae_joint_feedback_check(const arachnae_joint_feedback_t *m)
 {
-    arachnae_status st = arachnae_joint_feedback_check(m);
-    uint16_t n;
-    if (st != ARACHNAE_OK)
-        return st;
-    n = 8u;
-    if (cap < n)
-        return ARACHNAE_BUFFER;
+    return check(m);
+}
+
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
+static uint8_t pack(const arachnae_joint_feedback_t *m, uint8_t *payload)
+{
     payload[0] = (uint8_t)((((unsigned)(uint16_t)m->angle >> 8) & 0xFFu));
     payload[1] = (uint8_t)(((unsigned)(uint16_t)m->angle & 0xFFu));
     payload[2] = (uint8_t)((((unsigned)(uint16_t)m->speed >> 8) & 0xFFu));
@@ -83,19 +88,29 @@ arachnae_status arachnae_joint_feedback_encode(const arachnae_joint_feedback_t *
     payload[5] = (uint8_t)(((unsigned)(uint16_t)m->current & 0xFFu));
     payload[6] = (uint8_t)(((unsigned)(uint16_t)m->temperature & 0xFFu));
     payload[7] = (uint8_t)(((unsigned)(uint16_t)m->flags & 0xFFu));
-    *len = (uint8_t)n;
+    return 8u;
+}
+
+arachnae_status arachnae_joint_feedback_encode(const arachnae_joint_feedback_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+{
+    arachnae_status st = check(m);
+    if (st != ARACHNAE_OK)
+        return st;
+    if (cap < 8u)
+        return ARACHNAE_BUFFER;
+    *len = pack(m, payload);
     return ARACHNAE_OK;
 }
 
 arachnae_status arachnae_joint_feedback_build(const arachnae_joint_feedback_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len)
 {
-    uint8_t len = 0;
-    uint16_t room = (cap > ARACHNAE_FRAME_OVERHEAD) ? (uint16_t)(cap - ARACHNAE_FRAME_OVERHEAD) : 0u;
-    arachnae_status st = arachnae_joint_feedback_encode(m, frame + ARACHNAE_FRAME_PAYLOAD, room, &len);
+    arachnae_status st = check(m);
     if (st != ARACHNAE_OK)
         return st;
-    return arachnae_frame_finish(frame, cap, dst, src, ARACHNAE_OP_JOINT_FEEDBACK, len, frame_len);
+    if (cap < ARACHNAE_FRAME_OVERHEAD + 8u)
+        return ARACHNAE_BUFFER;
+    return arachnae_frame_seal(ARACHNAE_OP_JOINT_FEEDBACK, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }
 
 /* angle: phys = raw * 1/10 + 0 deg. Integer milli-units, rounding half away from zero (codegen/encoding.py). */

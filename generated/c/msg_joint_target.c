@@ -23,17 +23,23 @@ arachnae_status arachnae_joint_target_validate(const uint8_t *payload, uint8_t l
     return ARACHNAE_OK;
 }
 
+void arachnae_joint_target_unpack(const uint8_t *payload, uint8_t len, arachnae_joint_target_t *out)
+{
+    (void)len;
+    out->angle = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[0] << 8) | (unsigned)payload[1]), 0x8000u, 0xFFFFu);
+    out->speed = (uint16_t)(((unsigned)payload[2] << 8) | (unsigned)payload[3]);
+}
+
 arachnae_status arachnae_joint_target_decode(const uint8_t *payload, uint8_t len, arachnae_joint_target_t *out)
 {
     arachnae_status st = arachnae_joint_target_validate(payload, len);
-    if (st != ARACHNAE_OK)
-        return st;
-    out->angle = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[0] << 8) | (unsigned)payload[1]), 0x8000u, 0xFFFFu);
-    out->speed = (uint16_t)(((unsigned)payload[2] << 8) | (unsigned)payload[3]);
-    return ARACHNAE_OK;
+    if (st == ARACHNAE_OK)
+        arachnae_joint_target_unpack(payload, len, out);
+    return st;
 }
 
-arachnae_status arachnae_joint_target_check(const arachnae_joint_target_t *m)
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
+static inline arachnae_status check(const arachnae_joint_target_t *m)
 {
     if (!(m->angle >= -1800 && m->angle <= 1800))
         return ARACHNAE_RANGE;
@@ -42,32 +48,41 @@ arachnae_status arachnae_joint_target_check(const arachnae_joint_target_t *m)
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_joint_target_encode(const arachnae_joint_target_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+arachnae_status arachnae_joint_target_check(const arachnae_joint_target_t *m)
 {
-    arachnae_status st = arachnae_joint_target_check(m);
-    uint16_t n;
-    if (st != ARACHNAE_OK)
-        return st;
-    n = 4u;
-    if (cap < n)
-        return ARACHNAE_BUFFER;
+    return check(m);
+}
+
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
+static uint8_t pack(const arachnae_joint_target_t *m, uint8_t *payload)
+{
     payload[0] = (uint8_t)((((unsigned)(uint16_t)m->angle >> 8) & 0xFFu));
     payload[1] = (uint8_t)(((unsigned)(uint16_t)m->angle & 0xFFu));
     payload[2] = (uint8_t)((((unsigned)(uint16_t)m->speed >> 8) & 0xFFu));
     payload[3] = (uint8_t)(((unsigned)(uint16_t)m->speed & 0xFFu));
-    *len = (uint8_t)n;
+    return 4u;
+}
+
+arachnae_status arachnae_joint_target_encode(const arachnae_joint_target_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+{
+    arachnae_status st = check(m);
+    if (st != ARACHNAE_OK)
+        return st;
+    if (cap < 4u)
+        return ARACHNAE_BUFFER;
+    *len = pack(m, payload);
     return ARACHNAE_OK;
 }
 
 arachnae_status arachnae_joint_target_build(const arachnae_joint_target_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len)
 {
-    uint8_t len = 0;
-    uint16_t room = (cap > ARACHNAE_FRAME_OVERHEAD) ? (uint16_t)(cap - ARACHNAE_FRAME_OVERHEAD) : 0u;
-    arachnae_status st = arachnae_joint_target_encode(m, frame + ARACHNAE_FRAME_PAYLOAD, room, &len);
+    arachnae_status st = check(m);
     if (st != ARACHNAE_OK)
         return st;
-    return arachnae_frame_finish(frame, cap, dst, src, ARACHNAE_OP_JOINT_TARGET, len, frame_len);
+    if (cap < ARACHNAE_FRAME_OVERHEAD + 4u)
+        return ARACHNAE_BUFFER;
+    return arachnae_frame_seal(ARACHNAE_OP_JOINT_TARGET, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }
 
 /* angle: phys = raw * 1/10 + 0 deg. Integer milli-units, rounding half away from zero (codegen/encoding.py). */

@@ -26,20 +26,25 @@ arachnae_status arachnae_lcd_text_validate(const uint8_t *payload, uint8_t len)
     return ARACHNAE_OK;
 }
 
+void arachnae_lcd_text_unpack(const uint8_t *payload, uint8_t len, arachnae_lcd_text_t *out)
+{
+    uint16_t i;
+    out->line = (uint8_t)((unsigned)payload[0]);
+    out->length = (uint8_t)((unsigned)payload[1]);
+    for (i = 0; i < (uint16_t)(len - 2u); i++)
+        out->text[i] = payload[2u + i];
+}
+
 arachnae_status arachnae_lcd_text_decode(const uint8_t *payload, uint8_t len, arachnae_lcd_text_t *out)
 {
     arachnae_status st = arachnae_lcd_text_validate(payload, len);
-    uint16_t i;
-    if (st != ARACHNAE_OK)
-        return st;
-    out->line = (uint8_t)((unsigned)payload[0]);
-    out->length = (uint8_t)((unsigned)payload[1]);
-    for (i = 0; i < out->length; i++)
-        out->text[i] = payload[2u + i];
-    return ARACHNAE_OK;
+    if (st == ARACHNAE_OK)
+        arachnae_lcd_text_unpack(payload, len, out);
+    return st;
 }
 
-arachnae_status arachnae_lcd_text_check(const arachnae_lcd_text_t *m)
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
+static inline arachnae_status check(const arachnae_lcd_text_t *m)
 {
     if (!(m->line <= 1u))
         return ARACHNAE_RANGE;
@@ -48,31 +53,40 @@ arachnae_status arachnae_lcd_text_check(const arachnae_lcd_text_t *m)
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_lcd_text_encode(const arachnae_lcd_text_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+arachnae_status arachnae_lcd_text_check(const arachnae_lcd_text_t *m)
 {
-    arachnae_status st = arachnae_lcd_text_check(m);
-    uint16_t n;
-    uint16_t i;
-    if (st != ARACHNAE_OK)
-        return st;
-    n = (uint16_t)(2u + m->length);
-    if (cap < n)
-        return ARACHNAE_BUFFER;
+    return check(m);
+}
+
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
+static uint8_t pack(const arachnae_lcd_text_t *m, uint8_t *payload)
+{
+    uint8_t i;
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->line & 0xFFu));
     payload[1] = (uint8_t)(((unsigned)(uint16_t)m->length & 0xFFu));
     for (i = 0; i < m->length; i++)
         payload[2u + i] = m->text[i];
-    *len = (uint8_t)n;
+    return (uint8_t)(2u + m->length);
+}
+
+arachnae_status arachnae_lcd_text_encode(const arachnae_lcd_text_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+{
+    arachnae_status st = check(m);
+    if (st != ARACHNAE_OK)
+        return st;
+    if (cap < (uint16_t)(2u + m->length))
+        return ARACHNAE_BUFFER;
+    *len = pack(m, payload);
     return ARACHNAE_OK;
 }
 
 arachnae_status arachnae_lcd_text_build(const arachnae_lcd_text_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len)
 {
-    uint8_t len = 0;
-    uint16_t room = (cap > ARACHNAE_FRAME_OVERHEAD) ? (uint16_t)(cap - ARACHNAE_FRAME_OVERHEAD) : 0u;
-    arachnae_status st = arachnae_lcd_text_encode(m, frame + ARACHNAE_FRAME_PAYLOAD, room, &len);
+    arachnae_status st = check(m);
     if (st != ARACHNAE_OK)
         return st;
-    return arachnae_frame_finish(frame, cap, dst, src, ARACHNAE_OP_LCD_TEXT, len, frame_len);
+    if (cap < ARACHNAE_FRAME_OVERHEAD + (uint16_t)(2u + m->length))
+        return ARACHNAE_BUFFER;
+    return arachnae_frame_seal(ARACHNAE_OP_LCD_TEXT, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

@@ -38,20 +38,26 @@ arachnae_status arachnae_leg_report_validate(const uint8_t *payload, uint8_t len
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_leg_report_decode(const uint8_t *payload, uint8_t len, arachnae_leg_report_t *out)
+void arachnae_leg_report_unpack(const uint8_t *payload, uint8_t len, arachnae_leg_report_t *out)
 {
-    arachnae_status st = arachnae_leg_report_validate(payload, len);
-    if (st != ARACHNAE_OK)
-        return st;
+    (void)len;
     out->flags = (uint8_t)((unsigned)payload[0]);
     out->x = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[1] << 8) | (unsigned)payload[2]), 0x8000u, 0xFFFFu);
     out->y = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[3] << 8) | (unsigned)payload[4]), 0x8000u, 0xFFFFu);
     out->z = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[5] << 8) | (unsigned)payload[6]), 0x8000u, 0xFFFFu);
     out->servo_temp = (int8_t)arachnae_sext((uint16_t)((unsigned)payload[7]), 0x80u, 0xFFu);
-    return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_leg_report_check(const arachnae_leg_report_t *m)
+arachnae_status arachnae_leg_report_decode(const uint8_t *payload, uint8_t len, arachnae_leg_report_t *out)
+{
+    arachnae_status st = arachnae_leg_report_validate(payload, len);
+    if (st == ARACHNAE_OK)
+        arachnae_leg_report_unpack(payload, len, out);
+    return st;
+}
+
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
+static inline arachnae_status check(const arachnae_leg_report_t *m)
 {
     if (!((((unsigned)m->flags) & 0xC0u) == 0u))
         return ARACHNAE_RANGE;
@@ -66,15 +72,14 @@ arachnae_status arachnae_leg_report_check(const arachnae_leg_report_t *m)
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_leg_report_encode(const arachnae_leg_report_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+arachnae_status arachnae_leg_report_check(const arachnae_leg_report_t *m)
 {
-    arachnae_status st = arachnae_leg_report_check(m);
-    uint16_t n;
-    if (st != ARACHNAE_OK)
-        return st;
-    n = 8u;
-    if (cap < n)
-        return ARACHNAE_BUFFER;
+    return check(m);
+}
+
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
+static uint8_t pack(const arachnae_leg_report_t *m, uint8_t *payload)
+{
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->flags & 0xFFu));
     payload[1] = (uint8_t)((((unsigned)(uint16_t)m->x >> 8) & 0xFFu));
     payload[2] = (uint8_t)(((unsigned)(uint16_t)m->x & 0xFFu));
@@ -83,19 +88,29 @@ arachnae_status arachnae_leg_report_encode(const arachnae_leg_report_t *m, uint8
     payload[5] = (uint8_t)((((unsigned)(uint16_t)m->z >> 8) & 0xFFu));
     payload[6] = (uint8_t)(((unsigned)(uint16_t)m->z & 0xFFu));
     payload[7] = (uint8_t)(((unsigned)(uint16_t)m->servo_temp & 0xFFu));
-    *len = (uint8_t)n;
+    return 8u;
+}
+
+arachnae_status arachnae_leg_report_encode(const arachnae_leg_report_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+{
+    arachnae_status st = check(m);
+    if (st != ARACHNAE_OK)
+        return st;
+    if (cap < 8u)
+        return ARACHNAE_BUFFER;
+    *len = pack(m, payload);
     return ARACHNAE_OK;
 }
 
 arachnae_status arachnae_leg_report_build(const arachnae_leg_report_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len)
 {
-    uint8_t len = 0;
-    uint16_t room = (cap > ARACHNAE_FRAME_OVERHEAD) ? (uint16_t)(cap - ARACHNAE_FRAME_OVERHEAD) : 0u;
-    arachnae_status st = arachnae_leg_report_encode(m, frame + ARACHNAE_FRAME_PAYLOAD, room, &len);
+    arachnae_status st = check(m);
     if (st != ARACHNAE_OK)
         return st;
-    return arachnae_frame_finish(frame, cap, dst, src, ARACHNAE_OP_LEG_REPORT, len, frame_len);
+    if (cap < ARACHNAE_FRAME_OVERHEAD + 8u)
+        return ARACHNAE_BUFFER;
+    return arachnae_frame_seal(ARACHNAE_OP_LEG_REPORT, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }
 
 /* x: phys = raw * 1/10 + 0 mm. Integer milli-units, rounding half away from zero (codegen/encoding.py). */

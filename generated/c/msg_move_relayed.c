@@ -28,18 +28,24 @@ arachnae_status arachnae_move_relayed_validate(const uint8_t *payload, uint8_t l
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_move_relayed_decode(const uint8_t *payload, uint8_t len, arachnae_move_relayed_t *out)
+void arachnae_move_relayed_unpack(const uint8_t *payload, uint8_t len, arachnae_move_relayed_t *out)
 {
-    arachnae_status st = arachnae_move_relayed_validate(payload, len);
-    if (st != ARACHNAE_OK)
-        return st;
+    (void)len;
     out->address = (uint8_t)((unsigned)payload[0]);
     out->mov_cmd = (uint8_t)((((unsigned)payload[1] >> 4) & 0x0Fu));
     out->param = (uint8_t)(((unsigned)payload[1] & 0x0Fu));
-    return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_move_relayed_check(const arachnae_move_relayed_t *m)
+arachnae_status arachnae_move_relayed_decode(const uint8_t *payload, uint8_t len, arachnae_move_relayed_t *out)
+{
+    arachnae_status st = arachnae_move_relayed_validate(payload, len);
+    if (st == ARACHNAE_OK)
+        arachnae_move_relayed_unpack(payload, len, out);
+    return st;
+}
+
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
+static inline arachnae_status check(const arachnae_move_relayed_t *m)
 {
     if (!(arachnae_is_node(m->address)))
         return ARACHNAE_RANGE;
@@ -50,28 +56,37 @@ arachnae_status arachnae_move_relayed_check(const arachnae_move_relayed_t *m)
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_move_relayed_encode(const arachnae_move_relayed_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+arachnae_status arachnae_move_relayed_check(const arachnae_move_relayed_t *m)
 {
-    arachnae_status st = arachnae_move_relayed_check(m);
-    uint16_t n;
-    if (st != ARACHNAE_OK)
-        return st;
-    n = 2u;
-    if (cap < n)
-        return ARACHNAE_BUFFER;
+    return check(m);
+}
+
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
+static uint8_t pack(const arachnae_move_relayed_t *m, uint8_t *payload)
+{
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->address & 0xFFu));
     payload[1] = (uint8_t)((((unsigned)(uint16_t)m->mov_cmd & 0x0Fu) << 4) | ((unsigned)(uint16_t)m->param & 0x0Fu));
-    *len = (uint8_t)n;
+    return 2u;
+}
+
+arachnae_status arachnae_move_relayed_encode(const arachnae_move_relayed_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+{
+    arachnae_status st = check(m);
+    if (st != ARACHNAE_OK)
+        return st;
+    if (cap < 2u)
+        return ARACHNAE_BUFFER;
+    *len = pack(m, payload);
     return ARACHNAE_OK;
 }
 
 arachnae_status arachnae_move_relayed_build(const arachnae_move_relayed_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len)
 {
-    uint8_t len = 0;
-    uint16_t room = (cap > ARACHNAE_FRAME_OVERHEAD) ? (uint16_t)(cap - ARACHNAE_FRAME_OVERHEAD) : 0u;
-    arachnae_status st = arachnae_move_relayed_encode(m, frame + ARACHNAE_FRAME_PAYLOAD, room, &len);
+    arachnae_status st = check(m);
     if (st != ARACHNAE_OK)
         return st;
-    return arachnae_frame_finish(frame, cap, dst, src, ARACHNAE_OP_MOVE_RELAYED, len, frame_len);
+    if (cap < ARACHNAE_FRAME_OVERHEAD + 2u)
+        return ARACHNAE_BUFFER;
+    return arachnae_frame_seal(ARACHNAE_OP_MOVE_RELAYED, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

@@ -13,5 +13,7 @@ arachnae_status arachnae_obj_both_validate(const uint8_t *payload, uint8_t len)
 
 arachnae_status arachnae_obj_both_build(uint8_t dst, uint8_t src, uint8_t *frame, uint16_t cap, uint16_t *frame_len)
 {
-    return arachnae_frame_finish(frame, cap, dst, src, ARACHNAE_OP_OBJ_BOTH, 0u, frame_len);
+    if (cap < ARACHNAE_FRAME_OVERHEAD)
+        return ARACHNAE_BUFFER;
+    return arachnae_frame_seal(ARACHNAE_OP_OBJ_BOTH, dst, src, frame, 0u, frame_len);
 }

@@ -25,19 +25,24 @@ arachnae_status arachnae_post_report_validate(const uint8_t *payload, uint8_t le
     return ARACHNAE_OK;
 }
 
+void arachnae_post_report_unpack(const uint8_t *payload, uint8_t len, arachnae_post_report_t *out)
+{
+    uint16_t i;
+    out->missing_count = (uint8_t)((unsigned)payload[0]);
+    for (i = 0; i < (uint16_t)(len - 1u); i++)
+        out->missing[i] = payload[1u + i];
+}
+
 arachnae_status arachnae_post_report_decode(const uint8_t *payload, uint8_t len, arachnae_post_report_t *out)
 {
     arachnae_status st = arachnae_post_report_validate(payload, len);
-    uint16_t i;
-    if (st != ARACHNAE_OK)
-        return st;
-    out->missing_count = (uint8_t)((unsigned)payload[0]);
-    for (i = 0; i < out->missing_count; i++)
-        out->missing[i] = payload[1u + i];
-    return ARACHNAE_OK;
+    if (st == ARACHNAE_OK)
+        arachnae_post_report_unpack(payload, len, out);
+    return st;
 }
 
-arachnae_status arachnae_post_report_check(const arachnae_post_report_t *m)
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
+static inline arachnae_status check(const arachnae_post_report_t *m)
 {
     uint16_t i;
     if (!(m->missing_count <= 24u))
@@ -48,30 +53,39 @@ arachnae_status arachnae_post_report_check(const arachnae_post_report_t *m)
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_post_report_encode(const arachnae_post_report_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+arachnae_status arachnae_post_report_check(const arachnae_post_report_t *m)
 {
-    arachnae_status st = arachnae_post_report_check(m);
-    uint16_t n;
-    uint16_t i;
-    if (st != ARACHNAE_OK)
-        return st;
-    n = (uint16_t)(1u + m->missing_count);
-    if (cap < n)
-        return ARACHNAE_BUFFER;
+    return check(m);
+}
+
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
+static uint8_t pack(const arachnae_post_report_t *m, uint8_t *payload)
+{
+    uint8_t i;
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->missing_count & 0xFFu));
     for (i = 0; i < m->missing_count; i++)
         payload[1u + i] = m->missing[i];
-    *len = (uint8_t)n;
+    return (uint8_t)(1u + m->missing_count);
+}
+
+arachnae_status arachnae_post_report_encode(const arachnae_post_report_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+{
+    arachnae_status st = check(m);
+    if (st != ARACHNAE_OK)
+        return st;
+    if (cap < (uint16_t)(1u + m->missing_count))
+        return ARACHNAE_BUFFER;
+    *len = pack(m, payload);
     return ARACHNAE_OK;
 }
 
 arachnae_status arachnae_post_report_build(const arachnae_post_report_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len)
 {
-    uint8_t len = 0;
-    uint16_t room = (cap > ARACHNAE_FRAME_OVERHEAD) ? (uint16_t)(cap - ARACHNAE_FRAME_OVERHEAD) : 0u;
-    arachnae_status st = arachnae_post_report_encode(m, frame + ARACHNAE_FRAME_PAYLOAD, room, &len);
+    arachnae_status st = check(m);
     if (st != ARACHNAE_OK)
         return st;
-    return arachnae_frame_finish(frame, cap, dst, src, ARACHNAE_OP_POST_REPORT, len, frame_len);
+    if (cap < ARACHNAE_FRAME_OVERHEAD + (uint16_t)(1u + m->missing_count))
+        return ARACHNAE_BUFFER;
+    return arachnae_frame_seal(ARACHNAE_OP_POST_REPORT, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

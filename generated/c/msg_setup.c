@@ -18,20 +18,26 @@ arachnae_status arachnae_setup_validate(const uint8_t *payload, uint8_t len)
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_setup_decode(const uint8_t *payload, uint8_t len, arachnae_setup_t *out)
+void arachnae_setup_unpack(const uint8_t *payload, uint8_t len, arachnae_setup_t *out)
 {
-    arachnae_status st = arachnae_setup_validate(payload, len);
-    if (st != ARACHNAE_OK)
-        return st;
+    (void)len;
     out->rate = (uint8_t)((((unsigned)payload[0] >> 4) & 0x0Fu));
     out->amplitude = (uint8_t)(((unsigned)payload[0] & 0x0Fu));
     out->inflection = (uint8_t)((unsigned)payload[1]);
     out->articulation = (uint8_t)((((unsigned)payload[2] >> 5) & 0x07u));
     out->reserved = (uint8_t)(((unsigned)payload[2] & 0x1Fu));
-    return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_setup_check(const arachnae_setup_t *m)
+arachnae_status arachnae_setup_decode(const uint8_t *payload, uint8_t len, arachnae_setup_t *out)
+{
+    arachnae_status st = arachnae_setup_validate(payload, len);
+    if (st == ARACHNAE_OK)
+        arachnae_setup_unpack(payload, len, out);
+    return st;
+}
+
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
+static inline arachnae_status check(const arachnae_setup_t *m)
 {
     if (!(m->rate <= 15u))
         return ARACHNAE_RANGE;
@@ -44,29 +50,38 @@ arachnae_status arachnae_setup_check(const arachnae_setup_t *m)
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_setup_encode(const arachnae_setup_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+arachnae_status arachnae_setup_check(const arachnae_setup_t *m)
 {
-    arachnae_status st = arachnae_setup_check(m);
-    uint16_t n;
-    if (st != ARACHNAE_OK)
-        return st;
-    n = 3u;
-    if (cap < n)
-        return ARACHNAE_BUFFER;
+    return check(m);
+}
+
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
+static uint8_t pack(const arachnae_setup_t *m, uint8_t *payload)
+{
     payload[0] = (uint8_t)((((unsigned)(uint16_t)m->rate & 0x0Fu) << 4) | ((unsigned)(uint16_t)m->amplitude & 0x0Fu));
     payload[1] = (uint8_t)(((unsigned)(uint16_t)m->inflection & 0xFFu));
     payload[2] = (uint8_t)((((unsigned)(uint16_t)m->articulation & 0x07u) << 5) | ((unsigned)(uint16_t)m->reserved & 0x1Fu));
-    *len = (uint8_t)n;
+    return 3u;
+}
+
+arachnae_status arachnae_setup_encode(const arachnae_setup_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+{
+    arachnae_status st = check(m);
+    if (st != ARACHNAE_OK)
+        return st;
+    if (cap < 3u)
+        return ARACHNAE_BUFFER;
+    *len = pack(m, payload);
     return ARACHNAE_OK;
 }
 
 arachnae_status arachnae_setup_build(const arachnae_setup_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len)
 {
-    uint8_t len = 0;
-    uint16_t room = (cap > ARACHNAE_FRAME_OVERHEAD) ? (uint16_t)(cap - ARACHNAE_FRAME_OVERHEAD) : 0u;
-    arachnae_status st = arachnae_setup_encode(m, frame + ARACHNAE_FRAME_PAYLOAD, room, &len);
+    arachnae_status st = check(m);
     if (st != ARACHNAE_OK)
         return st;
-    return arachnae_frame_finish(frame, cap, dst, src, ARACHNAE_OP_SETUP, len, frame_len);
+    if (cap < ARACHNAE_FRAME_OVERHEAD + 3u)
+        return ARACHNAE_BUFFER;
+    return arachnae_frame_seal(ARACHNAE_OP_SETUP, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

@@ -23,18 +23,24 @@ arachnae_status arachnae_speak_resident_validate(const uint8_t *payload, uint8_t
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_speak_resident_decode(const uint8_t *payload, uint8_t len, arachnae_speak_resident_t *out)
+void arachnae_speak_resident_unpack(const uint8_t *payload, uint8_t len, arachnae_speak_resident_t *out)
 {
-    arachnae_status st = arachnae_speak_resident_validate(payload, len);
-    if (st != ARACHNAE_OK)
-        return st;
+    (void)len;
     out->repeat = (uint8_t)((unsigned)payload[0]);
     out->length = (uint8_t)((unsigned)payload[1]);
     out->index = (uint8_t)((unsigned)payload[2]);
-    return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_speak_resident_check(const arachnae_speak_resident_t *m)
+arachnae_status arachnae_speak_resident_decode(const uint8_t *payload, uint8_t len, arachnae_speak_resident_t *out)
+{
+    arachnae_status st = arachnae_speak_resident_validate(payload, len);
+    if (st == ARACHNAE_OK)
+        arachnae_speak_resident_unpack(payload, len, out);
+    return st;
+}
+
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
+static inline arachnae_status check(const arachnae_speak_resident_t *m)
 {
     if (!(m->length <= 0u))
         return ARACHNAE_RANGE;
@@ -43,29 +49,38 @@ arachnae_status arachnae_speak_resident_check(const arachnae_speak_resident_t *m
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_speak_resident_encode(const arachnae_speak_resident_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+arachnae_status arachnae_speak_resident_check(const arachnae_speak_resident_t *m)
 {
-    arachnae_status st = arachnae_speak_resident_check(m);
-    uint16_t n;
-    if (st != ARACHNAE_OK)
-        return st;
-    n = 3u;
-    if (cap < n)
-        return ARACHNAE_BUFFER;
+    return check(m);
+}
+
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
+static uint8_t pack(const arachnae_speak_resident_t *m, uint8_t *payload)
+{
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->repeat & 0xFFu));
     payload[1] = (uint8_t)(((unsigned)(uint16_t)m->length & 0xFFu));
     payload[2] = (uint8_t)(((unsigned)(uint16_t)m->index & 0xFFu));
-    *len = (uint8_t)n;
+    return 3u;
+}
+
+arachnae_status arachnae_speak_resident_encode(const arachnae_speak_resident_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+{
+    arachnae_status st = check(m);
+    if (st != ARACHNAE_OK)
+        return st;
+    if (cap < 3u)
+        return ARACHNAE_BUFFER;
+    *len = pack(m, payload);
     return ARACHNAE_OK;
 }
 
 arachnae_status arachnae_speak_resident_build(const arachnae_speak_resident_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len)
 {
-    uint8_t len = 0;
-    uint16_t room = (cap > ARACHNAE_FRAME_OVERHEAD) ? (uint16_t)(cap - ARACHNAE_FRAME_OVERHEAD) : 0u;
-    arachnae_status st = arachnae_speak_resident_encode(m, frame + ARACHNAE_FRAME_PAYLOAD, room, &len);
+    arachnae_status st = check(m);
     if (st != ARACHNAE_OK)
         return st;
-    return arachnae_frame_finish(frame, cap, dst, src, ARACHNAE_OP_SPEAK_RESIDENT, len, frame_len);
+    if (cap < ARACHNAE_FRAME_OVERHEAD + 3u)
+        return ARACHNAE_BUFFER;
+    return arachnae_frame_seal(ARACHNAE_OP_SPEAK_RESIDENT, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

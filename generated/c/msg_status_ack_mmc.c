@@ -33,19 +33,25 @@ arachnae_status arachnae_status_ack_mmc_validate(const uint8_t *payload, uint8_t
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_status_ack_mmc_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_mmc_t *out)
+void arachnae_status_ack_mmc_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_mmc_t *out)
 {
-    arachnae_status st = arachnae_status_ack_mmc_validate(payload, len);
-    if (st != ARACHNAE_OK)
-        return st;
+    (void)len;
     out->gait = (uint8_t)((((unsigned)payload[0] >> 4) & 0x0Fu));
     out->direction = (uint8_t)(((unsigned)payload[0] & 0x0Fu));
     out->leg = (uint8_t)((((unsigned)payload[1] >> 4) & 0x0Fu));
     out->error = (uint8_t)(((unsigned)payload[1] & 0x0Fu));
-    return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_status_ack_mmc_check(const arachnae_status_ack_mmc_t *m)
+arachnae_status arachnae_status_ack_mmc_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_mmc_t *out)
+{
+    arachnae_status st = arachnae_status_ack_mmc_validate(payload, len);
+    if (st == ARACHNAE_OK)
+        arachnae_status_ack_mmc_unpack(payload, len, out);
+    return st;
+}
+
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
+static inline arachnae_status check(const arachnae_status_ack_mmc_t *m)
 {
     if (!(m->gait >= 7u && m->gait <= 9u))
         return ARACHNAE_RANGE;
@@ -58,28 +64,37 @@ arachnae_status arachnae_status_ack_mmc_check(const arachnae_status_ack_mmc_t *m
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_status_ack_mmc_encode(const arachnae_status_ack_mmc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+arachnae_status arachnae_status_ack_mmc_check(const arachnae_status_ack_mmc_t *m)
 {
-    arachnae_status st = arachnae_status_ack_mmc_check(m);
-    uint16_t n;
-    if (st != ARACHNAE_OK)
-        return st;
-    n = 2u;
-    if (cap < n)
-        return ARACHNAE_BUFFER;
+    return check(m);
+}
+
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
+static uint8_t pack(const arachnae_status_ack_mmc_t *m, uint8_t *payload)
+{
     payload[0] = (uint8_t)((((unsigned)(uint16_t)m->gait & 0x0Fu) << 4) | ((unsigned)(uint16_t)m->direction & 0x0Fu));
     payload[1] = (uint8_t)((((unsigned)(uint16_t)m->leg & 0x0Fu) << 4) | ((unsigned)(uint16_t)m->error & 0x0Fu));
-    *len = (uint8_t)n;
+    return 2u;
+}
+
+arachnae_status arachnae_status_ack_mmc_encode(const arachnae_status_ack_mmc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+{
+    arachnae_status st = check(m);
+    if (st != ARACHNAE_OK)
+        return st;
+    if (cap < 2u)
+        return ARACHNAE_BUFFER;
+    *len = pack(m, payload);
     return ARACHNAE_OK;
 }
 
 arachnae_status arachnae_status_ack_mmc_build(const arachnae_status_ack_mmc_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len)
 {
-    uint8_t len = 0;
-    uint16_t room = (cap > ARACHNAE_FRAME_OVERHEAD) ? (uint16_t)(cap - ARACHNAE_FRAME_OVERHEAD) : 0u;
-    arachnae_status st = arachnae_status_ack_mmc_encode(m, frame + ARACHNAE_FRAME_PAYLOAD, room, &len);
+    arachnae_status st = check(m);
     if (st != ARACHNAE_OK)
         return st;
-    return arachnae_frame_finish(frame, cap, dst, src, ARACHNAE_OP_STATUS_ACK_MMC, len, frame_len);
+    if (cap < ARACHNAE_FRAME_OVERHEAD + 2u)
+        return ARACHNAE_BUFFER;
+    return arachnae_frame_seal(ARACHNAE_OP_STATUS_ACK_MMC, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

@@ -18,43 +18,58 @@ arachnae_status arachnae_status_ack_order_validate(const uint8_t *payload, uint8
     return ARACHNAE_OK;
 }
 
+void arachnae_status_ack_order_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_order_t *out)
+{
+    (void)len;
+    out->status = (uint8_t)((unsigned)payload[0]);
+}
+
 arachnae_status arachnae_status_ack_order_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_order_t *out)
 {
     arachnae_status st = arachnae_status_ack_order_validate(payload, len);
-    if (st != ARACHNAE_OK)
-        return st;
-    out->status = (uint8_t)((unsigned)payload[0]);
-    return ARACHNAE_OK;
+    if (st == ARACHNAE_OK)
+        arachnae_status_ack_order_unpack(payload, len, out);
+    return st;
 }
 
-arachnae_status arachnae_status_ack_order_check(const arachnae_status_ack_order_t *m)
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
+static inline arachnae_status check(const arachnae_status_ack_order_t *m)
 {
     if (!(m->status <= 1u))
         return ARACHNAE_RANGE;
     return ARACHNAE_OK;
 }
 
+arachnae_status arachnae_status_ack_order_check(const arachnae_status_ack_order_t *m)
+{
+    return check(m);
+}
+
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
+static uint8_t pack(const arachnae_status_ack_order_t *m, uint8_t *payload)
+{
+    payload[0] = (uint8_t)(((unsigned)(uint16_t)m->status & 0xFFu));
+    return 1u;
+}
+
 arachnae_status arachnae_status_ack_order_encode(const arachnae_status_ack_order_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
 {
-    arachnae_status st = arachnae_status_ack_order_check(m);
-    uint16_t n;
+    arachnae_status st = check(m);
     if (st != ARACHNAE_OK)
         return st;
-    n = 1u;
-    if (cap < n)
+    if (cap < 1u)
         return ARACHNAE_BUFFER;
-    payload[0] = (uint8_t)(((unsigned)(uint16_t)m->status & 0xFFu));
-    *len = (uint8_t)n;
+    *len = pack(m, payload);
     return ARACHNAE_OK;
 }
 
 arachnae_status arachnae_status_ack_order_build(const arachnae_status_ack_order_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len)
 {
-    uint8_t len = 0;
-    uint16_t room = (cap > ARACHNAE_FRAME_OVERHEAD) ? (uint16_t)(cap - ARACHNAE_FRAME_OVERHEAD) : 0u;
-    arachnae_status st = arachnae_status_ack_order_encode(m, frame + ARACHNAE_FRAME_PAYLOAD, room, &len);
+    arachnae_status st = check(m);
     if (st != ARACHNAE_OK)
         return st;
-    return arachnae_frame_finish(frame, cap, dst, src, ARACHNAE_OP_STATUS_ACK_ORDER, len, frame_len);
+    if (cap < ARACHNAE_FRAME_OVERHEAD + 1u)
+        return ARACHNAE_BUFFER;
+    return arachnae_frame_seal(ARACHNAE_OP_STATUS_ACK_ORDER, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

@@ -18,45 +18,60 @@ arachnae_status arachnae_xmit_data_psc_validate(const uint8_t *payload, uint8_t 
     return ARACHNAE_OK;
 }
 
+void arachnae_xmit_data_psc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_psc_t *out)
+{
+    (void)len;
+    out->voltage = (uint8_t)((unsigned)payload[0]);
+}
+
 arachnae_status arachnae_xmit_data_psc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_psc_t *out)
 {
     arachnae_status st = arachnae_xmit_data_psc_validate(payload, len);
-    if (st != ARACHNAE_OK)
-        return st;
-    out->voltage = (uint8_t)((unsigned)payload[0]);
-    return ARACHNAE_OK;
+    if (st == ARACHNAE_OK)
+        arachnae_xmit_data_psc_unpack(payload, len, out);
+    return st;
 }
 
-arachnae_status arachnae_xmit_data_psc_check(const arachnae_xmit_data_psc_t *m)
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
+static inline arachnae_status check(const arachnae_xmit_data_psc_t *m)
 {
     if (!(m->voltage >= 40u && m->voltage <= 200u))
         return ARACHNAE_RANGE;
     return ARACHNAE_OK;
 }
 
+arachnae_status arachnae_xmit_data_psc_check(const arachnae_xmit_data_psc_t *m)
+{
+    return check(m);
+}
+
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
+static uint8_t pack(const arachnae_xmit_data_psc_t *m, uint8_t *payload)
+{
+    payload[0] = (uint8_t)(((unsigned)(uint16_t)m->voltage & 0xFFu));
+    return 1u;
+}
+
 arachnae_status arachnae_xmit_data_psc_encode(const arachnae_xmit_data_psc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
 {
-    arachnae_status st = arachnae_xmit_data_psc_check(m);
-    uint16_t n;
+    arachnae_status st = check(m);
     if (st != ARACHNAE_OK)
         return st;
-    n = 1u;
-    if (cap < n)
+    if (cap < 1u)
         return ARACHNAE_BUFFER;
-    payload[0] = (uint8_t)(((unsigned)(uint16_t)m->voltage & 0xFFu));
-    *len = (uint8_t)n;
+    *len = pack(m, payload);
     return ARACHNAE_OK;
 }
 
 arachnae_status arachnae_xmit_data_psc_build(const arachnae_xmit_data_psc_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len)
 {
-    uint8_t len = 0;
-    uint16_t room = (cap > ARACHNAE_FRAME_OVERHEAD) ? (uint16_t)(cap - ARACHNAE_FRAME_OVERHEAD) : 0u;
-    arachnae_status st = arachnae_xmit_data_psc_encode(m, frame + ARACHNAE_FRAME_PAYLOAD, room, &len);
+    arachnae_status st = check(m);
     if (st != ARACHNAE_OK)
         return st;
-    return arachnae_frame_finish(frame, cap, dst, src, ARACHNAE_OP_XMIT_DATA_PSC, len, frame_len);
+    if (cap < ARACHNAE_FRAME_OVERHEAD + 1u)
+        return ARACHNAE_BUFFER;
+    return arachnae_frame_seal(ARACHNAE_OP_XMIT_DATA_PSC, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }
 
 /* voltage: phys = raw * 1/200 + 4 V. Integer milli-units, rounding half away from zero (codegen/encoding.py). */

@@ -18,48 +18,63 @@ arachnae_status arachnae_xmit_data_usrc_validate(const uint8_t *payload, uint8_t
     return ARACHNAE_OK;
 }
 
+void arachnae_xmit_data_usrc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_usrc_t *out)
+{
+    (void)len;
+    out->distance = (uint8_t)((unsigned)payload[0]);
+    out->angle = (uint16_t)(((unsigned)payload[1] << 8) | (unsigned)payload[2]);
+}
+
 arachnae_status arachnae_xmit_data_usrc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_usrc_t *out)
 {
     arachnae_status st = arachnae_xmit_data_usrc_validate(payload, len);
-    if (st != ARACHNAE_OK)
-        return st;
-    out->distance = (uint8_t)((unsigned)payload[0]);
-    out->angle = (uint16_t)(((unsigned)payload[1] << 8) | (unsigned)payload[2]);
-    return ARACHNAE_OK;
+    if (st == ARACHNAE_OK)
+        arachnae_xmit_data_usrc_unpack(payload, len, out);
+    return st;
 }
 
-arachnae_status arachnae_xmit_data_usrc_check(const arachnae_xmit_data_usrc_t *m)
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
+static inline arachnae_status check(const arachnae_xmit_data_usrc_t *m)
 {
     if (!(m->angle <= 359u))
         return ARACHNAE_RANGE;
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_xmit_data_usrc_encode(const arachnae_xmit_data_usrc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+arachnae_status arachnae_xmit_data_usrc_check(const arachnae_xmit_data_usrc_t *m)
 {
-    arachnae_status st = arachnae_xmit_data_usrc_check(m);
-    uint16_t n;
-    if (st != ARACHNAE_OK)
-        return st;
-    n = 3u;
-    if (cap < n)
-        return ARACHNAE_BUFFER;
+    return check(m);
+}
+
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
+static uint8_t pack(const arachnae_xmit_data_usrc_t *m, uint8_t *payload)
+{
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->distance & 0xFFu));
     payload[1] = (uint8_t)((((unsigned)(uint16_t)m->angle >> 8) & 0xFFu));
     payload[2] = (uint8_t)(((unsigned)(uint16_t)m->angle & 0xFFu));
-    *len = (uint8_t)n;
+    return 3u;
+}
+
+arachnae_status arachnae_xmit_data_usrc_encode(const arachnae_xmit_data_usrc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+{
+    arachnae_status st = check(m);
+    if (st != ARACHNAE_OK)
+        return st;
+    if (cap < 3u)
+        return ARACHNAE_BUFFER;
+    *len = pack(m, payload);
     return ARACHNAE_OK;
 }
 
 arachnae_status arachnae_xmit_data_usrc_build(const arachnae_xmit_data_usrc_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len)
 {
-    uint8_t len = 0;
-    uint16_t room = (cap > ARACHNAE_FRAME_OVERHEAD) ? (uint16_t)(cap - ARACHNAE_FRAME_OVERHEAD) : 0u;
-    arachnae_status st = arachnae_xmit_data_usrc_encode(m, frame + ARACHNAE_FRAME_PAYLOAD, room, &len);
+    arachnae_status st = check(m);
     if (st != ARACHNAE_OK)
         return st;
-    return arachnae_frame_finish(frame, cap, dst, src, ARACHNAE_OP_XMIT_DATA_USRC, len, frame_len);
+    if (cap < ARACHNAE_FRAME_OVERHEAD + 3u)
+        return ARACHNAE_BUFFER;
+    return arachnae_frame_seal(ARACHNAE_OP_XMIT_DATA_USRC, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }
 
 /* distance: phys = raw * 2/51 + 0 m. Integer milli-units, rounding half away from zero (codegen/encoding.py). */

@@ -33,20 +33,26 @@ arachnae_status arachnae_xmit_record_validate(const uint8_t *payload, uint8_t le
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_xmit_record_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_record_t *out)
+void arachnae_xmit_record_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_record_t *out)
 {
-    arachnae_status st = arachnae_xmit_record_validate(payload, len);
-    if (st != ARACHNAE_OK)
-        return st;
+    (void)len;
     out->target = (uint8_t)((unsigned)payload[0]);
     out->source = (uint8_t)((unsigned)payload[1]);
     out->kind = (uint8_t)((unsigned)payload[2]);
     out->channel = (uint16_t)(((unsigned)payload[3] << 8) | (unsigned)payload[4]);
     out->value = (uint8_t)((unsigned)payload[5]);
-    return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_xmit_record_check(const arachnae_xmit_record_t *m)
+arachnae_status arachnae_xmit_record_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_record_t *out)
+{
+    arachnae_status st = arachnae_xmit_record_validate(payload, len);
+    if (st == ARACHNAE_OK)
+        arachnae_xmit_record_unpack(payload, len, out);
+    return st;
+}
+
+/* RANGE on the struct; static inline so that encode and build need no call to it. */
+static inline arachnae_status check(const arachnae_xmit_record_t *m)
 {
     if (!(arachnae_is_node(m->target)))
         return ARACHNAE_RANGE;
@@ -59,32 +65,41 @@ arachnae_status arachnae_xmit_record_check(const arachnae_xmit_record_t *m)
     return ARACHNAE_OK;
 }
 
-arachnae_status arachnae_xmit_record_encode(const arachnae_xmit_record_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+arachnae_status arachnae_xmit_record_check(const arachnae_xmit_record_t *m)
 {
-    arachnae_status st = arachnae_xmit_record_check(m);
-    uint16_t n;
-    if (st != ARACHNAE_OK)
-        return st;
-    n = 6u;
-    if (cap < n)
-        return ARACHNAE_BUFFER;
+    return check(m);
+}
+
+/* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
+static uint8_t pack(const arachnae_xmit_record_t *m, uint8_t *payload)
+{
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->target & 0xFFu));
     payload[1] = (uint8_t)(((unsigned)(uint16_t)m->source & 0xFFu));
     payload[2] = (uint8_t)(((unsigned)(uint16_t)m->kind & 0xFFu));
     payload[3] = (uint8_t)((((unsigned)(uint16_t)m->channel >> 8) & 0xFFu));
     payload[4] = (uint8_t)(((unsigned)(uint16_t)m->channel & 0xFFu));
     payload[5] = (uint8_t)(((unsigned)(uint16_t)m->value & 0xFFu));
-    *len = (uint8_t)n;
+    return 6u;
+}
+
+arachnae_status arachnae_xmit_record_encode(const arachnae_xmit_record_t *m, uint8_t *payload, uint16_t cap, uint8_t *len)
+{
+    arachnae_status st = check(m);
+    if (st != ARACHNAE_OK)
+        return st;
+    if (cap < 6u)
+        return ARACHNAE_BUFFER;
+    *len = pack(m, payload);
     return ARACHNAE_OK;
 }
 
 arachnae_status arachnae_xmit_record_build(const arachnae_xmit_record_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len)
 {
-    uint8_t len = 0;
-    uint16_t room = (cap > ARACHNAE_FRAME_OVERHEAD) ? (uint16_t)(cap - ARACHNAE_FRAME_OVERHEAD) : 0u;
-    arachnae_status st = arachnae_xmit_record_encode(m, frame + ARACHNAE_FRAME_PAYLOAD, room, &len);
+    arachnae_status st = check(m);
     if (st != ARACHNAE_OK)
         return st;
-    return arachnae_frame_finish(frame, cap, dst, src, ARACHNAE_OP_XMIT_RECORD, len, frame_len);
+    if (cap < ARACHNAE_FRAME_OVERHEAD + 6u)
+        return ARACHNAE_BUFFER;
+    return arachnae_frame_seal(ARACHNAE_OP_XMIT_RECORD, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

@@ -20,6 +20,19 @@ typedef struct lcp_node {
     /* checked frames for this node that reached no callback: an opcode the role does not
      * receive, a bad payload, a reply that could not be built */
     arachnae_unhandled unhandled;
+    /* the skeleton's working space during lcp_dispatch(): here, not on the stack, so the
+     * dispatch needs no stack frame (issue 15); callbacks get &rx as their header */
+    arachnae_header rx;
+    union {
+        arachnae_id_ack_t reply_id_ack;
+        arachnae_status_ack_order_t reply_status;
+        arachnae_id_ack_t rx_id_ack;
+        arachnae_status_ack_order_t rx_status_ack_order;
+        arachnae_leg_target_t rx_leg_target;
+        arachnae_joint_feedback_t rx_joint_feedback;
+    } msg;  /* the reply being built, or the message being delivered */
+    uint8_t out[7];
+    uint16_t out_len;
 } lcp_node;
 
 /* ADDRESS if `address` is not a LCP node of the spec. */

@@ -20,92 +20,66 @@ arachnae_status lsc_node_init(lsc_node *node, uint8_t address, void *user)
 arachnae_status lsc_payload_check(uint8_t opcode, const uint8_t *payload, uint8_t len)
 {
     switch (opcode) {
-    case ARACHNAE_OP_INIT:
-        return arachnae_init_validate(payload, len);
-    case ARACHNAE_OP_ID_REQ:
-        return arachnae_id_req_validate(payload, len);
-    case ARACHNAE_OP_STATUS_REQ:
-        return arachnae_status_req_validate(payload, len);
-    case ARACHNAE_OP_XMIT_DATA:
-        return arachnae_xmit_data_validate(payload, len);
     case ARACHNAE_OP_SET_ALARM_LSC:
         return arachnae_set_alarm_lsc_validate(payload, len);
+    case ARACHNAE_OP_INIT:
+    case ARACHNAE_OP_ID_REQ:
+    case ARACHNAE_OP_STATUS_REQ:
+    case ARACHNAE_OP_XMIT_DATA:
+        return (len != 0u) ? ARACHNAE_LENGTH : ARACHNAE_OK;
     default:
         return ARACHNAE_OPCODE;
     }
 }
 
-/* seed 3.2.2: ID_ACK carries the node's own address */
-static arachnae_status reply_id_ack(lsc_node *node, const arachnae_header *h)
-{
-    arachnae_id_ack_t ack;
-    uint8_t out[ARACHNAE_ID_ACK_FRAME_MAX];
-    uint16_t n = 0;
-    arachnae_status st;
-    ack.address = node->address;
-    st = arachnae_id_ack_build(&ack, h->src, node->address, out, ARACHNAE_ID_ACK_FRAME_MAX, &n);
-    if (st == ARACHNAE_OK)
-        lsc_send(node, out, n);
-    return st;
-}
-
-/* seed 3.2.10: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_ORDER) */
-static arachnae_status reply_status(lsc_node *node, const arachnae_header *h)
-{
-    arachnae_status_ack_order_t reply = {0};
-    uint8_t out[ARACHNAE_STATUS_ACK_ORDER_FRAME_MAX];
-    uint16_t n = 0;
-    arachnae_status st;
-    lsc_on_status_req(node, h, &reply);
-    st = arachnae_status_ack_order_build(&reply, h->src, node->address, out, ARACHNAE_STATUS_ACK_ORDER_FRAME_MAX, &n);
-    if (st == ARACHNAE_OK)
-        lsc_send(node, out, n);
-    return st;
-}
-
-/* A checked frame for us: decode it and call its callback. */
+/* A frame for us whose payload passed lsc_payload_check: call its callback, or
+ * build and send the reply to a request (one reply buffer and one send for all of them). */
 static arachnae_status deliver(lsc_node *node, const arachnae_header *h, const uint8_t *payload)
 {
     arachnae_status st;
     switch (h->opcode) {
     case ARACHNAE_OP_INIT:
-        st = arachnae_init_validate(payload, h->length);
-        if (st == ARACHNAE_OK)
-            lsc_on_init(node, h);
-        return st;
+        lsc_on_init(node, h);
+        return ARACHNAE_OK;
     case ARACHNAE_OP_ID_REQ:
-        st = arachnae_id_req_validate(payload, h->length);
-        if (st != ARACHNAE_OK || h->dst == ARACHNAE_ADDR_BROADCAST)
-            return st;
-        return reply_id_ack(node, h);
+        /* requests to broadcast get no reply: every node answering would collide */
+        if (h->dst == ARACHNAE_ADDR_BROADCAST)
+            return ARACHNAE_OK;
+        /* seed 3.2.2: ID_ACK carries the node's own address */
+        node->msg.reply_id_ack.address = node->address;
+        st = arachnae_id_ack_build(&node->msg.reply_id_ack, h->src, node->address, node->out, sizeof node->out, &node->out_len);
+        break;
     case ARACHNAE_OP_STATUS_REQ:
-        st = arachnae_status_req_validate(payload, h->length);
-        if (st != ARACHNAE_OK || h->dst == ARACHNAE_ADDR_BROADCAST)
-            return st;
-        return reply_status(node, h);
+        if (h->dst == ARACHNAE_ADDR_BROADCAST)
+            return ARACHNAE_OK;
+        /* seed 3.2.10: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_ORDER) */
+        node->msg.reply_status.status = 0;
+        lsc_on_status_req(node, h, &node->msg.reply_status);
+        st = arachnae_status_ack_order_build(&node->msg.reply_status, h->src, node->address, node->out, sizeof node->out, &node->out_len);
+        break;
     case ARACHNAE_OP_XMIT_DATA:
-        st = arachnae_xmit_data_validate(payload, h->length);
-        if (st == ARACHNAE_OK)
-            lsc_on_xmit_data(node, h);
-        return st;
-    case ARACHNAE_OP_SET_ALARM_LSC: {
-        arachnae_set_alarm_lsc_t msg;
-        st = arachnae_set_alarm_lsc_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            lsc_on_set_alarm_lsc(node, h, &msg);
-        return st;
-    }
+        lsc_on_xmit_data(node, h);
+        return ARACHNAE_OK;
+    case ARACHNAE_OP_SET_ALARM_LSC:
+        arachnae_set_alarm_lsc_unpack(payload, h->length, &node->msg.rx_set_alarm_lsc);
+        lsc_on_set_alarm_lsc(node, h, &node->msg.rx_set_alarm_lsc);
+        return ARACHNAE_OK;
     default:
-        return ARACHNAE_OPCODE;
+        return ARACHNAE_OK;
     }
+    if (st == ARACHNAE_OK)
+        lsc_send(node, node->out, node->out_len);
+    return st;
 }
 
 arachnae_status lsc_dispatch(lsc_node *node, const uint8_t *frame, uint16_t len)
 {
-    arachnae_header h;
     arachnae_status st = arachnae_frame_check(frame, len, node->address);
     if (st != ARACHNAE_OK)
         return st;
-    arachnae_frame_header(frame, &h);
-    return arachnae_unhandled_note(&node->unhandled, h.opcode, deliver(node, &h, frame + ARACHNAE_FRAME_PAYLOAD));
+    arachnae_frame_header(frame, &node->rx);
+    st = lsc_payload_check(node->rx.opcode, frame + ARACHNAE_FRAME_PAYLOAD, node->rx.length);
+    if (st == ARACHNAE_OK)
+        st = deliver(node, &node->rx, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_unhandled_note(&node->unhandled, node->rx.opcode, st);
 }

@@ -28,87 +28,66 @@ arachnae_status mcp_payload_check(uint8_t opcode, const uint8_t *payload, uint8_
         return arachnae_status_ack_mmc_validate(payload, len);
     case ARACHNAE_OP_POST_REPORT:
         return arachnae_post_report_validate(payload, len);
-    case ARACHNAE_OP_POST_REQ:
-        return arachnae_post_req_validate(payload, len);
-    case ARACHNAE_OP_XMIT_REQ:
-        return arachnae_xmit_req_validate(payload, len);
     case ARACHNAE_OP_XMIT_RECORD:
         return arachnae_xmit_record_validate(payload, len);
     case ARACHNAE_OP_MOVE:
         return arachnae_move_validate(payload, len);
+    case ARACHNAE_OP_POST_REQ:
+    case ARACHNAE_OP_XMIT_REQ:
+        return (len != 0u) ? ARACHNAE_LENGTH : ARACHNAE_OK;
     default:
         return ARACHNAE_OPCODE;
     }
 }
 
-/* A checked frame for us: decode it and call its callback. */
+/* A frame for us whose payload passed mcp_payload_check: call its callback, or
+ * build and send the reply to a request (one reply buffer and one send for all of them). */
 static arachnae_status deliver(mcp_node *node, const arachnae_header *h, const uint8_t *payload)
 {
-    arachnae_status st;
     switch (h->opcode) {
-    case ARACHNAE_OP_ID_ACK: {
-        arachnae_id_ack_t msg;
-        st = arachnae_id_ack_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            mcp_on_id_ack(node, h, &msg);
-        return st;
-    }
-    case ARACHNAE_OP_STATUS_ACK_BUSY: {
-        arachnae_status_ack_busy_t msg;
-        st = arachnae_status_ack_busy_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            mcp_on_status_ack_busy(node, h, &msg);
-        return st;
-    }
-    case ARACHNAE_OP_STATUS_ACK_MMC: {
-        arachnae_status_ack_mmc_t msg;
-        st = arachnae_status_ack_mmc_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            mcp_on_status_ack_mmc(node, h, &msg);
-        return st;
-    }
-    case ARACHNAE_OP_POST_REPORT: {
-        arachnae_post_report_t msg;
-        st = arachnae_post_report_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            mcp_on_post_report(node, h, &msg);
-        return st;
-    }
+    case ARACHNAE_OP_ID_ACK:
+        arachnae_id_ack_unpack(payload, h->length, &node->msg.rx_id_ack);
+        mcp_on_id_ack(node, h, &node->msg.rx_id_ack);
+        return ARACHNAE_OK;
+    case ARACHNAE_OP_STATUS_ACK_BUSY:
+        arachnae_status_ack_busy_unpack(payload, h->length, &node->msg.rx_status_ack_busy);
+        mcp_on_status_ack_busy(node, h, &node->msg.rx_status_ack_busy);
+        return ARACHNAE_OK;
+    case ARACHNAE_OP_STATUS_ACK_MMC:
+        arachnae_status_ack_mmc_unpack(payload, h->length, &node->msg.rx_status_ack_mmc);
+        mcp_on_status_ack_mmc(node, h, &node->msg.rx_status_ack_mmc);
+        return ARACHNAE_OK;
+    case ARACHNAE_OP_POST_REPORT:
+        arachnae_post_report_unpack(payload, h->length, &node->msg.rx_post_report);
+        mcp_on_post_report(node, h, &node->msg.rx_post_report);
+        return ARACHNAE_OK;
     case ARACHNAE_OP_POST_REQ:
-        st = arachnae_post_req_validate(payload, h->length);
-        if (st == ARACHNAE_OK)
-            mcp_on_post_req(node, h);
-        return st;
+        mcp_on_post_req(node, h);
+        return ARACHNAE_OK;
     case ARACHNAE_OP_XMIT_REQ:
-        st = arachnae_xmit_req_validate(payload, h->length);
-        if (st == ARACHNAE_OK)
-            mcp_on_xmit_req(node, h);
-        return st;
-    case ARACHNAE_OP_XMIT_RECORD: {
-        arachnae_xmit_record_t msg;
-        st = arachnae_xmit_record_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            mcp_on_xmit_record(node, h, &msg);
-        return st;
-    }
-    case ARACHNAE_OP_MOVE: {
-        arachnae_move_t msg;
-        st = arachnae_move_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            mcp_on_move(node, h, &msg);
-        return st;
-    }
+        mcp_on_xmit_req(node, h);
+        return ARACHNAE_OK;
+    case ARACHNAE_OP_XMIT_RECORD:
+        arachnae_xmit_record_unpack(payload, h->length, &node->msg.rx_xmit_record);
+        mcp_on_xmit_record(node, h, &node->msg.rx_xmit_record);
+        return ARACHNAE_OK;
+    case ARACHNAE_OP_MOVE:
+        arachnae_move_unpack(payload, h->length, &node->msg.rx_move);
+        mcp_on_move(node, h, &node->msg.rx_move);
+        return ARACHNAE_OK;
     default:
-        return ARACHNAE_OPCODE;
+        return ARACHNAE_OK;
     }
 }
 
 arachnae_status mcp_dispatch(mcp_node *node, const uint8_t *frame, uint16_t len)
 {
-    arachnae_header h;
     arachnae_status st = arachnae_frame_check(frame, len, node->address);
     if (st != ARACHNAE_OK)
         return st;
-    arachnae_frame_header(frame, &h);
-    return arachnae_unhandled_note(&node->unhandled, h.opcode, deliver(node, &h, frame + ARACHNAE_FRAME_PAYLOAD));
+    arachnae_frame_header(frame, &node->rx);
+    st = mcp_payload_check(node->rx.opcode, frame + ARACHNAE_FRAME_PAYLOAD, node->rx.length);
+    if (st == ARACHNAE_OK)
+        st = deliver(node, &node->rx, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_unhandled_note(&node->unhandled, node->rx.opcode, st);
 }

@@ -20,6 +20,17 @@ typedef struct mcp_node {
     /* checked frames for this node that reached no callback: an opcode the role does not
      * receive, a bad payload, a reply that could not be built */
     arachnae_unhandled unhandled;
+    /* the skeleton's working space during mcp_dispatch(): here, not on the stack, so the
+     * dispatch needs no stack frame (issue 15); callbacks get &rx as their header */
+    arachnae_header rx;
+    union {
+        arachnae_id_ack_t rx_id_ack;
+        arachnae_status_ack_busy_t rx_status_ack_busy;
+        arachnae_status_ack_mmc_t rx_status_ack_mmc;
+        arachnae_post_report_t rx_post_report;
+        arachnae_xmit_record_t rx_xmit_record;
+        arachnae_move_t rx_move;
+    } msg;  /* the reply being built, or the message being delivered */
 } mcp_node;
 
 /* ADDRESS if `address` is not a MCP node of the spec. */

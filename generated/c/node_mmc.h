@@ -20,6 +20,20 @@ typedef struct mmc_node {
     /* checked frames for this node that reached no callback: an opcode the role does not
      * receive, a bad payload, a reply that could not be built */
     arachnae_unhandled unhandled;
+    /* the skeleton's working space during mmc_dispatch(): here, not on the stack, so the
+     * dispatch needs no stack frame (issue 15); callbacks get &rx as their header */
+    arachnae_header rx;
+    union {
+        arachnae_id_ack_t reply_id_ack;
+        arachnae_status_ack_mmc_t reply_status;
+        arachnae_id_ack_t rx_id_ack;
+        arachnae_status_ack_order_t rx_status_ack_order;
+        arachnae_post_report_t rx_post_report;
+        arachnae_move_relayed_t rx_move_relayed;
+        arachnae_leg_report_t rx_leg_report;
+    } msg;  /* the reply being built, or the message being delivered */
+    uint8_t out[8];
+    uint16_t out_len;
 } mmc_node;
 
 /* ADDRESS if `address` is not a MMC node of the spec. */

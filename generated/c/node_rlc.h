@@ -20,6 +20,15 @@ typedef struct rlc_node {
     /* checked frames for this node that reached no callback: an opcode the role does not
      * receive, a bad payload, a reply that could not be built */
     arachnae_unhandled unhandled;
+    /* the skeleton's working space during rlc_dispatch(): here, not on the stack, so the
+     * dispatch needs no stack frame (issue 15); callbacks get &rx as their header */
+    arachnae_header rx;
+    union {
+        arachnae_id_ack_t reply_id_ack;
+        arachnae_status_ack_busy_t reply_status;
+    } msg;  /* the reply being built, or the message being delivered */
+    uint8_t out[7];
+    uint16_t out_len;
 } rlc_node;
 
 /* ADDRESS if `address` is not a RLC node of the spec. */

@@ -20,30 +20,12 @@ arachnae_status spu_node_init(spu_node *node, uint8_t address, void *user)
 arachnae_status spu_payload_check(uint8_t opcode, const uint8_t *payload, uint8_t len)
 {
     switch (opcode) {
-    case ARACHNAE_OP_INIT:
-        return arachnae_init_validate(payload, len);
-    case ARACHNAE_OP_ID_REQ:
-        return arachnae_id_req_validate(payload, len);
     case ARACHNAE_OP_ID_ACK:
         return arachnae_id_ack_validate(payload, len);
-    case ARACHNAE_OP_STATUS_REQ:
-        return arachnae_status_req_validate(payload, len);
     case ARACHNAE_OP_STATUS_ACK_ORDER:
         return arachnae_status_ack_order_validate(payload, len);
     case ARACHNAE_OP_STATUS_ACK_RANGE:
         return arachnae_status_ack_range_validate(payload, len);
-    case ARACHNAE_OP_POST_QUERY:
-        return arachnae_post_query_validate(payload, len);
-    case ARACHNAE_OP_XMIT_GRANT:
-        return arachnae_xmit_grant_validate(payload, len);
-    case ARACHNAE_OP_DATA_RDY:
-        return arachnae_data_rdy_validate(payload, len);
-    case ARACHNAE_OP_OBJ_LEFT:
-        return arachnae_obj_left_validate(payload, len);
-    case ARACHNAE_OP_OBJ_RIGHT:
-        return arachnae_obj_right_validate(payload, len);
-    case ARACHNAE_OP_OBJ_BOTH:
-        return arachnae_obj_both_validate(payload, len);
     case ARACHNAE_OP_XMIT_DATA_USRC:
         return arachnae_xmit_data_usrc_validate(payload, len);
     case ARACHNAE_OP_XMIT_DATA_TPSC:
@@ -58,170 +40,120 @@ arachnae_status spu_payload_check(uint8_t opcode, const uint8_t *payload, uint8_
         return arachnae_xmit_data_lsc_validate(payload, len);
     case ARACHNAE_OP_XMIT_DATA_PSC:
         return arachnae_xmit_data_psc_validate(payload, len);
+    case ARACHNAE_OP_INIT:
+    case ARACHNAE_OP_ID_REQ:
+    case ARACHNAE_OP_STATUS_REQ:
+    case ARACHNAE_OP_POST_QUERY:
+    case ARACHNAE_OP_XMIT_GRANT:
+    case ARACHNAE_OP_DATA_RDY:
+    case ARACHNAE_OP_OBJ_LEFT:
+    case ARACHNAE_OP_OBJ_RIGHT:
+    case ARACHNAE_OP_OBJ_BOTH:
+        return (len != 0u) ? ARACHNAE_LENGTH : ARACHNAE_OK;
     default:
         return ARACHNAE_OPCODE;
     }
 }
 
-/* seed 3.2.2: ID_ACK carries the node's own address */
-static arachnae_status reply_id_ack(spu_node *node, const arachnae_header *h)
-{
-    arachnae_id_ack_t ack;
-    uint8_t out[ARACHNAE_ID_ACK_FRAME_MAX];
-    uint16_t n = 0;
-    arachnae_status st;
-    ack.address = node->address;
-    st = arachnae_id_ack_build(&ack, h->src, node->address, out, ARACHNAE_ID_ACK_FRAME_MAX, &n);
-    if (st == ARACHNAE_OK)
-        spu_send(node, out, n);
-    return st;
-}
-
-/* seed 3.2.3: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_BUSY) */
-static arachnae_status reply_status(spu_node *node, const arachnae_header *h)
-{
-    arachnae_status_ack_busy_t reply = {0};
-    uint8_t out[ARACHNAE_STATUS_ACK_BUSY_FRAME_MAX];
-    uint16_t n = 0;
-    arachnae_status st;
-    spu_on_status_req(node, h, &reply);
-    st = arachnae_status_ack_busy_build(&reply, h->src, node->address, out, ARACHNAE_STATUS_ACK_BUSY_FRAME_MAX, &n);
-    if (st == ARACHNAE_OK)
-        spu_send(node, out, n);
-    return st;
-}
-
-/* A checked frame for us: decode it and call its callback. */
+/* A frame for us whose payload passed spu_payload_check: call its callback, or
+ * build and send the reply to a request (one reply buffer and one send for all of them). */
 static arachnae_status deliver(spu_node *node, const arachnae_header *h, const uint8_t *payload)
 {
     arachnae_status st;
     switch (h->opcode) {
     case ARACHNAE_OP_INIT:
-        st = arachnae_init_validate(payload, h->length);
-        if (st == ARACHNAE_OK)
-            spu_on_init(node, h);
-        return st;
+        spu_on_init(node, h);
+        return ARACHNAE_OK;
     case ARACHNAE_OP_ID_REQ:
-        st = arachnae_id_req_validate(payload, h->length);
-        if (st != ARACHNAE_OK || h->dst == ARACHNAE_ADDR_BROADCAST)
-            return st;
-        return reply_id_ack(node, h);
+        /* requests to broadcast get no reply: every node answering would collide */
+        if (h->dst == ARACHNAE_ADDR_BROADCAST)
+            return ARACHNAE_OK;
+        /* seed 3.2.2: ID_ACK carries the node's own address */
+        node->msg.reply_id_ack.address = node->address;
+        st = arachnae_id_ack_build(&node->msg.reply_id_ack, h->src, node->address, node->out, sizeof node->out, &node->out_len);
+        break;
     case ARACHNAE_OP_STATUS_REQ:
-        st = arachnae_status_req_validate(payload, h->length);
-        if (st != ARACHNAE_OK || h->dst == ARACHNAE_ADDR_BROADCAST)
-            return st;
-        return reply_status(node, h);
-    case ARACHNAE_OP_ID_ACK: {
-        arachnae_id_ack_t msg;
-        st = arachnae_id_ack_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            spu_on_id_ack(node, h, &msg);
-        return st;
-    }
-    case ARACHNAE_OP_STATUS_ACK_ORDER: {
-        arachnae_status_ack_order_t msg;
-        st = arachnae_status_ack_order_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            spu_on_status_ack_order(node, h, &msg);
-        return st;
-    }
-    case ARACHNAE_OP_STATUS_ACK_RANGE: {
-        arachnae_status_ack_range_t msg;
-        st = arachnae_status_ack_range_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            spu_on_status_ack_range(node, h, &msg);
-        return st;
-    }
+        if (h->dst == ARACHNAE_ADDR_BROADCAST)
+            return ARACHNAE_OK;
+        /* seed 3.2.3: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_BUSY) */
+        node->msg.reply_status.status = 0;
+        spu_on_status_req(node, h, &node->msg.reply_status);
+        st = arachnae_status_ack_busy_build(&node->msg.reply_status, h->src, node->address, node->out, sizeof node->out, &node->out_len);
+        break;
+    case ARACHNAE_OP_ID_ACK:
+        arachnae_id_ack_unpack(payload, h->length, &node->msg.rx_id_ack);
+        spu_on_id_ack(node, h, &node->msg.rx_id_ack);
+        return ARACHNAE_OK;
+    case ARACHNAE_OP_STATUS_ACK_ORDER:
+        arachnae_status_ack_order_unpack(payload, h->length, &node->msg.rx_status_ack_order);
+        spu_on_status_ack_order(node, h, &node->msg.rx_status_ack_order);
+        return ARACHNAE_OK;
+    case ARACHNAE_OP_STATUS_ACK_RANGE:
+        arachnae_status_ack_range_unpack(payload, h->length, &node->msg.rx_status_ack_range);
+        spu_on_status_ack_range(node, h, &node->msg.rx_status_ack_range);
+        return ARACHNAE_OK;
     case ARACHNAE_OP_POST_QUERY:
-        st = arachnae_post_query_validate(payload, h->length);
-        if (st == ARACHNAE_OK)
-            spu_on_post_query(node, h);
-        return st;
+        spu_on_post_query(node, h);
+        return ARACHNAE_OK;
     case ARACHNAE_OP_XMIT_GRANT:
-        st = arachnae_xmit_grant_validate(payload, h->length);
-        if (st == ARACHNAE_OK)
-            spu_on_xmit_grant(node, h);
-        return st;
+        spu_on_xmit_grant(node, h);
+        return ARACHNAE_OK;
     case ARACHNAE_OP_DATA_RDY:
-        st = arachnae_data_rdy_validate(payload, h->length);
-        if (st == ARACHNAE_OK)
-            spu_on_data_rdy(node, h);
-        return st;
+        spu_on_data_rdy(node, h);
+        return ARACHNAE_OK;
     case ARACHNAE_OP_OBJ_LEFT:
-        st = arachnae_obj_left_validate(payload, h->length);
-        if (st == ARACHNAE_OK)
-            spu_on_obj_left(node, h);
-        return st;
+        spu_on_obj_left(node, h);
+        return ARACHNAE_OK;
     case ARACHNAE_OP_OBJ_RIGHT:
-        st = arachnae_obj_right_validate(payload, h->length);
-        if (st == ARACHNAE_OK)
-            spu_on_obj_right(node, h);
-        return st;
+        spu_on_obj_right(node, h);
+        return ARACHNAE_OK;
     case ARACHNAE_OP_OBJ_BOTH:
-        st = arachnae_obj_both_validate(payload, h->length);
-        if (st == ARACHNAE_OK)
-            spu_on_obj_both(node, h);
-        return st;
-    case ARACHNAE_OP_XMIT_DATA_USRC: {
-        arachnae_xmit_data_usrc_t msg;
-        st = arachnae_xmit_data_usrc_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            spu_on_xmit_data_usrc(node, h, &msg);
-        return st;
-    }
-    case ARACHNAE_OP_XMIT_DATA_TPSC: {
-        arachnae_xmit_data_tpsc_t msg;
-        st = arachnae_xmit_data_tpsc_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            spu_on_xmit_data_tpsc(node, h, &msg);
-        return st;
-    }
-    case ARACHNAE_OP_XMIT_DATA_IRRC: {
-        arachnae_xmit_data_irrc_t msg;
-        st = arachnae_xmit_data_irrc_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            spu_on_xmit_data_irrc(node, h, &msg);
-        return st;
-    }
-    case ARACHNAE_OP_XMIT_DATA_ISC: {
-        arachnae_xmit_data_isc_t msg;
-        st = arachnae_xmit_data_isc_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            spu_on_xmit_data_isc(node, h, &msg);
-        return st;
-    }
-    case ARACHNAE_OP_XMIT_DATA_TSC: {
-        arachnae_xmit_data_tsc_t msg;
-        st = arachnae_xmit_data_tsc_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            spu_on_xmit_data_tsc(node, h, &msg);
-        return st;
-    }
-    case ARACHNAE_OP_XMIT_DATA_LSC: {
-        arachnae_xmit_data_lsc_t msg;
-        st = arachnae_xmit_data_lsc_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            spu_on_xmit_data_lsc(node, h, &msg);
-        return st;
-    }
-    case ARACHNAE_OP_XMIT_DATA_PSC: {
-        arachnae_xmit_data_psc_t msg;
-        st = arachnae_xmit_data_psc_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            spu_on_xmit_data_psc(node, h, &msg);
-        return st;
-    }
+        spu_on_obj_both(node, h);
+        return ARACHNAE_OK;
+    case ARACHNAE_OP_XMIT_DATA_USRC:
+        arachnae_xmit_data_usrc_unpack(payload, h->length, &node->msg.rx_xmit_data_usrc);
+        spu_on_xmit_data_usrc(node, h, &node->msg.rx_xmit_data_usrc);
+        return ARACHNAE_OK;
+    case ARACHNAE_OP_XMIT_DATA_TPSC:
+        arachnae_xmit_data_tpsc_unpack(payload, h->length, &node->msg.rx_xmit_data_tpsc);
+        spu_on_xmit_data_tpsc(node, h, &node->msg.rx_xmit_data_tpsc);
+        return ARACHNAE_OK;
+    case ARACHNAE_OP_XMIT_DATA_IRRC:
+        arachnae_xmit_data_irrc_unpack(payload, h->length, &node->msg.rx_xmit_data_irrc);
+        spu_on_xmit_data_irrc(node, h, &node->msg.rx_xmit_data_irrc);
+        return ARACHNAE_OK;
+    case ARACHNAE_OP_XMIT_DATA_ISC:
+        arachnae_xmit_data_isc_unpack(payload, h->length, &node->msg.rx_xmit_data_isc);
+        spu_on_xmit_data_isc(node, h, &node->msg.rx_xmit_data_isc);
+        return ARACHNAE_OK;
+    case ARACHNAE_OP_XMIT_DATA_TSC:
+        arachnae_xmit_data_tsc_unpack(payload, h->length, &node->msg.rx_xmit_data_tsc);
+        spu_on_xmit_data_tsc(node, h, &node->msg.rx_xmit_data_tsc);
+        return ARACHNAE_OK;
+    case ARACHNAE_OP_XMIT_DATA_LSC:
+        arachnae_xmit_data_lsc_unpack(payload, h->length, &node->msg.rx_xmit_data_lsc);
+        spu_on_xmit_data_lsc(node, h, &node->msg.rx_xmit_data_lsc);
+        return ARACHNAE_OK;
+    case ARACHNAE_OP_XMIT_DATA_PSC:
+        arachnae_xmit_data_psc_unpack(payload, h->length, &node->msg.rx_xmit_data_psc);
+        spu_on_xmit_data_psc(node, h, &node->msg.rx_xmit_data_psc);
+        return ARACHNAE_OK;
     default:
-        return ARACHNAE_OPCODE;
+        return ARACHNAE_OK;
     }
+    if (st == ARACHNAE_OK)
+        spu_send(node, node->out, node->out_len);
+    return st;
 }
 
 arachnae_status spu_dispatch(spu_node *node, const uint8_t *frame, uint16_t len)
 {
-    arachnae_header h;
     arachnae_status st = arachnae_frame_check(frame, len, node->address);
     if (st != ARACHNAE_OK)
         return st;
-    arachnae_frame_header(frame, &h);
-    return arachnae_unhandled_note(&node->unhandled, h.opcode, deliver(node, &h, frame + ARACHNAE_FRAME_PAYLOAD));
+    arachnae_frame_header(frame, &node->rx);
+    st = spu_payload_check(node->rx.opcode, frame + ARACHNAE_FRAME_PAYLOAD, node->rx.length);
+    if (st == ARACHNAE_OK)
+        st = deliver(node, &node->rx, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_unhandled_note(&node->unhandled, node->rx.opcode, st);
 }

@@ -20,6 +20,25 @@ typedef struct spu_node {
     /* checked frames for this node that reached no callback: an opcode the role does not
      * receive, a bad payload, a reply that could not be built */
     arachnae_unhandled unhandled;
+    /* the skeleton's working space during spu_dispatch(): here, not on the stack, so the
+     * dispatch needs no stack frame (issue 15); callbacks get &rx as their header */
+    arachnae_header rx;
+    union {
+        arachnae_id_ack_t reply_id_ack;
+        arachnae_status_ack_busy_t reply_status;
+        arachnae_id_ack_t rx_id_ack;
+        arachnae_status_ack_order_t rx_status_ack_order;
+        arachnae_status_ack_range_t rx_status_ack_range;
+        arachnae_xmit_data_usrc_t rx_xmit_data_usrc;
+        arachnae_xmit_data_tpsc_t rx_xmit_data_tpsc;
+        arachnae_xmit_data_irrc_t rx_xmit_data_irrc;
+        arachnae_xmit_data_isc_t rx_xmit_data_isc;
+        arachnae_xmit_data_tsc_t rx_xmit_data_tsc;
+        arachnae_xmit_data_lsc_t rx_xmit_data_lsc;
+        arachnae_xmit_data_psc_t rx_xmit_data_psc;
+    } msg;  /* the reply being built, or the message being delivered */
+    uint8_t out[7];
+    uint16_t out_len;
 } spu_node;
 
 /* ADDRESS if `address` is not a SPU node of the spec. */

@@ -20,103 +20,74 @@ arachnae_status ssc_node_init(ssc_node *node, uint8_t address, void *user)
 arachnae_status ssc_payload_check(uint8_t opcode, const uint8_t *payload, uint8_t len)
 {
     switch (opcode) {
-    case ARACHNAE_OP_INIT:
-        return arachnae_init_validate(payload, len);
-    case ARACHNAE_OP_ID_REQ:
-        return arachnae_id_req_validate(payload, len);
-    case ARACHNAE_OP_STATUS_REQ:
-        return arachnae_status_req_validate(payload, len);
     case ARACHNAE_OP_SETUP:
         return arachnae_setup_validate(payload, len);
     case ARACHNAE_OP_SPEAK:
         return arachnae_speak_validate(payload, len);
     case ARACHNAE_OP_SPEAK_RESIDENT:
         return arachnae_speak_resident_validate(payload, len);
+    case ARACHNAE_OP_INIT:
+    case ARACHNAE_OP_ID_REQ:
+    case ARACHNAE_OP_STATUS_REQ:
+        return (len != 0u) ? ARACHNAE_LENGTH : ARACHNAE_OK;
     default:
         return ARACHNAE_OPCODE;
     }
 }
 
-/* seed 3.2.2: ID_ACK carries the node's own address */
-static arachnae_status reply_id_ack(ssc_node *node, const arachnae_header *h)
-{
-    arachnae_id_ack_t ack;
-    uint8_t out[ARACHNAE_ID_ACK_FRAME_MAX];
-    uint16_t n = 0;
-    arachnae_status st;
-    ack.address = node->address;
-    st = arachnae_id_ack_build(&ack, h->src, node->address, out, ARACHNAE_ID_ACK_FRAME_MAX, &n);
-    if (st == ARACHNAE_OK)
-        ssc_send(node, out, n);
-    return st;
-}
-
-/* seed 3.2.3: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_BUSY) */
-static arachnae_status reply_status(ssc_node *node, const arachnae_header *h)
-{
-    arachnae_status_ack_busy_t reply = {0};
-    uint8_t out[ARACHNAE_STATUS_ACK_BUSY_FRAME_MAX];
-    uint16_t n = 0;
-    arachnae_status st;
-    ssc_on_status_req(node, h, &reply);
-    st = arachnae_status_ack_busy_build(&reply, h->src, node->address, out, ARACHNAE_STATUS_ACK_BUSY_FRAME_MAX, &n);
-    if (st == ARACHNAE_OK)
-        ssc_send(node, out, n);
-    return st;
-}
-
-/* A checked frame for us: decode it and call its callback. */
+/* A frame for us whose payload passed ssc_payload_check: call its callback, or
+ * build and send the reply to a request (one reply buffer and one send for all of them). */
 static arachnae_status deliver(ssc_node *node, const arachnae_header *h, const uint8_t *payload)
 {
     arachnae_status st;
     switch (h->opcode) {
     case ARACHNAE_OP_INIT:
-        st = arachnae_init_validate(payload, h->length);
-        if (st == ARACHNAE_OK)
-            ssc_on_init(node, h);
-        return st;
+        ssc_on_init(node, h);
+        return ARACHNAE_OK;
     case ARACHNAE_OP_ID_REQ:
-        st = arachnae_id_req_validate(payload, h->length);
-        if (st != ARACHNAE_OK || h->dst == ARACHNAE_ADDR_BROADCAST)
-            return st;
-        return reply_id_ack(node, h);
+        /* requests to broadcast get no reply: every node answering would collide */
+        if (h->dst == ARACHNAE_ADDR_BROADCAST)
+            return ARACHNAE_OK;
+        /* seed 3.2.2: ID_ACK carries the node's own address */
+        node->msg.reply_id_ack.address = node->address;
+        st = arachnae_id_ack_build(&node->msg.reply_id_ack, h->src, node->address, node->out, sizeof node->out, &node->out_len);
+        break;
     case ARACHNAE_OP_STATUS_REQ:
-        st = arachnae_status_req_validate(payload, h->length);
-        if (st != ARACHNAE_OK || h->dst == ARACHNAE_ADDR_BROADCAST)
-            return st;
-        return reply_status(node, h);
-    case ARACHNAE_OP_SETUP: {
-        arachnae_setup_t msg;
-        st = arachnae_setup_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            ssc_on_setup(node, h, &msg);
-        return st;
-    }
-    case ARACHNAE_OP_SPEAK: {
-        arachnae_speak_t msg;
-        st = arachnae_speak_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            ssc_on_speak(node, h, &msg);
-        return st;
-    }
-    case ARACHNAE_OP_SPEAK_RESIDENT: {
-        arachnae_speak_resident_t msg;
-        st = arachnae_speak_resident_decode(payload, h->length, &msg);
-        if (st == ARACHNAE_OK)
-            ssc_on_speak_resident(node, h, &msg);
-        return st;
-    }
+        if (h->dst == ARACHNAE_ADDR_BROADCAST)
+            return ARACHNAE_OK;
+        /* seed 3.2.3: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_BUSY) */
+        node->msg.reply_status.status = 0;
+        ssc_on_status_req(node, h, &node->msg.reply_status);
+        st = arachnae_status_ack_busy_build(&node->msg.reply_status, h->src, node->address, node->out, sizeof node->out, &node->out_len);
+        break;
+    case ARACHNAE_OP_SETUP:
+        arachnae_setup_unpack(payload, h->length, &node->msg.rx_setup);
+        ssc_on_setup(node, h, &node->msg.rx_setup);
+        return ARACHNAE_OK;
+    case ARACHNAE_OP_SPEAK:
+        arachnae_speak_unpack(payload, h->length, &node->msg.rx_speak);
+        ssc_on_speak(node, h, &node->msg.rx_speak);
+        return ARACHNAE_OK;
+    case ARACHNAE_OP_SPEAK_RESIDENT:
+        arachnae_speak_resident_unpack(payload, h->length, &node->msg.rx_speak_resident);
+        ssc_on_speak_resident(node, h, &node->msg.rx_speak_resident);
+        return ARACHNAE_OK;
     default:
-        return ARACHNAE_OPCODE;
+        return ARACHNAE_OK;
     }
+    if (st == ARACHNAE_OK)
+        ssc_send(node, node->out, node->out_len);
+    return st;
 }
 
 arachnae_status ssc_dispatch(ssc_node *node, const uint8_t *frame, uint16_t len)
 {
-    arachnae_header h;
     arachnae_status st = arachnae_frame_check(frame, len, node->address);
     if (st != ARACHNAE_OK)
         return st;
-    arachnae_frame_header(frame, &h);
-    return arachnae_unhandled_note(&node->unhandled, h.opcode, deliver(node, &h, frame + ARACHNAE_FRAME_PAYLOAD));
+    arachnae_frame_header(frame, &node->rx);
+    st = ssc_payload_check(node->rx.opcode, frame + ARACHNAE_FRAME_PAYLOAD, node->rx.length);
+    if (st == ARACHNAE_OK)
+        st = deliver(node, &node->rx, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_unhandled_note(&node->unhandled, node->rx.opcode, st);
 }

@@ -20,6 +20,17 @@ typedef struct usrc_node {
     /* checked frames for this node that reached no callback: an opcode the role does not
      * receive, a bad payload, a reply that could not be built */
     arachnae_unhandled unhandled;
+    /* the skeleton's working space during usrc_dispatch(): here, not on the stack, so the
+     * dispatch needs no stack frame (issue 15); callbacks get &rx as their header */
+    arachnae_header rx;
+    union {
+        arachnae_id_ack_t reply_id_ack;
+        arachnae_status_ack_range_t reply_status;
+        arachnae_head_set_abs_t rx_head_set_abs;
+        arachnae_head_set_rel_t rx_head_set_rel;
+    } msg;  /* the reply being built, or the message being delivered */
+    uint8_t out[7];
+    uint16_t out_len;
 } usrc_node;
 
 /* ADDRESS if `address` is not a USRC node of the spec. */
