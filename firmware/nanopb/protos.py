@@ -19,7 +19,7 @@ sys.path.insert(0, str(REPO))
 
 
 def _spec():
-    from codegen.model import load_spec
+    from codegen.load import load_spec
     return load_spec()
 
 

@@ -10,10 +10,10 @@ import pytest
 from tests.firmware.conftest import FIRMWARE, make
 
 SENSORS = ("usrc", "tpsc", "irrc", "isc", "tsc", "lsc", "psc")
-# Issue 15 targets (AVR flash, codec + skeleton): not reached yet, see test_issue_15_targets.
-SENSOR_TARGET, TPSC_TARGET, ROLE_TARGET = 1024, 633, 2048
-# What the generated C reaches today, with a little room: a regression past these fails.
-SENSOR_CEILING, TPSC_CEILING, ROLE_CEILING = 1420, 1240, 2330
+# What the generated C reaches today, with a little room: a regression past these fails. Issue 15's targets
+# (sensors 1024, TPSC 633 = 1.5x its baseline, any role 2048) are not reached yet; `make size` prints each
+# role against its budget and the issue's note carries the gap.
+SENSOR_CEILING, TPSC_CEILING, ROLE_CEILING = 1540, 1240, 2330   # with the sensors' C behaviours (their XMIT_DATA builders linked)
 
 
 def report(build, *extra):
@@ -44,16 +44,6 @@ def test_codec_and_skeleton_stay_under_todays_ceilings(firmware_built):
     assert used["tpsc"] <= TPSC_CEILING, used
     assert all(used[r] <= SENSOR_CEILING for r in SENSORS), used
     assert all(n <= ROLE_CEILING for n in used.values()), used
-
-
-@pytest.mark.xfail(strict=True, reason="issue 15 open: sensors at 1.2-1.4 KiB, TPSC 2.9x its baseline, SPU 2.3 KiB")
-def test_issue_15_targets(firmware_built):
-    """A sensor role in 1 KiB, the TPSC within 1.5x of the hand-written baseline, any role in 2 KiB.
-    Strict: once the generated C gets there this passes, xfail fails, and the ceilings above move."""
-    used = avr_codec_skeleton(report(firmware_built)[1])
-    assert used["tpsc"] <= TPSC_TARGET
-    assert all(used[r] <= SENSOR_TARGET for r in SENSORS)
-    assert all(n <= ROLE_TARGET for n in used.values())
 
 
 def test_make_size_prints_nanopb_beside_ours_and_the_baseline(firmware_built):
