@@ -39,8 +39,8 @@ def test_unmutated_code_has_no_violation(missing_scenario):
 
 
 def test_backoff_rank_mutation_is_caught(monkeypatch, replay_dir):
-    rank = Runtime._rank
-    monkeypatch.setattr(Runtime, "_rank", lambda self, bus: len(self.net.requesters[bus]) - 1 - rank(self, bus))
+    rank = Runtime.rank
+    monkeypatch.setattr(Runtime, "rank", lambda self, bus: len(self.net.requesters[bus]) - 1 - rank(self, bus))
     t, bus, rule = first(runner.run(str(replay_dir / "replay_arbitration_sensor_spec.yaml")))
     assert (bus, rule) == ("sensor", "backoff_slot") and t > 3.0
 
