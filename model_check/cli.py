@@ -50,6 +50,7 @@ _OPTIONS = {
     "arbitration": {"variant", "scope", "bus", "size"},
     "id_retry": {"bus", "size"},
     "post": {"legs", "no_symmetry"},
+    "reaction": {"size"},          # --size: other slaves kept per bus (build_models: others)
     "all": {"variant", "scope", "size", "legs", "no_symmetry"},
 }
 _DEFAULTS = {"variant": "spec", "scope": None, "bus": None, "size": None, "legs": None, "no_symmetry": False}
