@@ -11,10 +11,14 @@ def register(sub: Any) -> None:
     tsub = t.add_subparsers(dest="trace_command", metavar="TRACECOMMAND", parser_class=type(t))
     tsub.required = True
     c = tsub.add_parser("check", help="check a trace.tsv: exit 1 and one line per protocol violation")
-    c.add_argument("trace", help="trace.tsv written by `arachnae sim run` (or captured in the same columns)")
+    c.add_argument("trace", help="trace.tsv written by `arachnae sim run` (or captured in the same columns), "
+                                 "or a pcapng capture (a run's bus.pcapng, `arachnae monitor --pcapng`)")
     c.add_argument("--arbitration", action="append", default=[], metavar="BUS=VARIANT",
                    help="the rule a contended bus ran: seed or spec (default spec), e.g. sensor=seed")
     c.add_argument("--spec", default=None, help="spec directory (default: the repository's spec/)")
+    c.add_argument("--untimed", action="store_true",
+                   help="the capture's time stamps are not the line's (a pty, a buffering USB adapter): "
+                        "check only the rules that need no clock")
     c.add_argument("--json", action="store_true", help="print the summary as JSON")
     c.set_defaults(func=_check)
 
@@ -37,8 +41,8 @@ def _check(args: argparse.Namespace) -> int:
 
     spec = load(args.spec)
     variants = _variants(args.arbitration, spec)
-    trace = read(args.trace, set(spec.buses))
-    report = validate(trace, spec, variants)
+    trace = read(args.trace, set(spec.buses), spec)
+    report = validate(trace, spec, variants, timed=not args.untimed)
     if args.json:
         print(json.dumps(dict(report.metrics(), all=[str(v) for v in report.violations]), indent=2))
     else:
@@ -47,5 +51,6 @@ def _check(args: argparse.Namespace) -> int:
         m = report.metrics()
         print(f"{args.trace}: {len(trace.frames)} frames, {m['violations']} protocol violation(s); "
               f"requests {m['requests']} (served {m['served']}, declined {m['declined']}, unchecked {m['unchecked']}), "
-              f"longest wait {m['max_wait_slots']} slots, K {m['k_slots']}")
+              + (f"longest wait {m['max_wait_slots']} slots, K {m['k_slots']}" if not args.untimed else
+                 f"untimed: checked {m['checked']}"))
     return 1 if report.violations else 0

@@ -4,12 +4,16 @@ One row per frame on a wire (times, bus, sending station, the codec's reading,
 the bytes heard, flags, the bytes sent) plus rows from the nodes' debug ports
 that the protocol rules need (bus column `debug`), e.g. the MCP's POST verdict.
 A capture from hardware may leave `sender`, `flags` and `sent` empty: the
-validator then works from the bytes heard and the frames' times alone.
+validator then works from the bytes heard and the frames' times alone. A pcapng
+capture (a run's bus.pcapng, `arachnae monitor --pcapng`) reads the same way
+(`from_capture`): its interfaces are buses, a frame ends when its bytes have
+left the line at the bus's baud rate, and it has no debug-port rows.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from arachnae.errors import UserError, located
 from arachnae_proto import CodecError
@@ -104,9 +108,43 @@ def _intact(data: bytes | None) -> bool:
         return False
 
 
-def read(path: str | Path, buses: set[str] | None = None) -> Trace:
-    """Read trace.tsv; any malformed line is a one-line `file:line: problem` UserError."""
+PCAPNG_MAGIC = bytes.fromhex("0a0d0d0a")      # a pcapng file starts with a section header block
+
+
+def from_capture(capture: Any, spec: Any, shown: str) -> Trace:
+    """A pcapng capture's frames as a trace: times from its first frame, ends at the spec's baud rate.
+
+    `line` is the frame's number in the capture (1 = the first), so a violation names it."""
+    t0 = min((f.time_ns for f in capture.frames), default=0)
+    frames = []
+    for no, c in enumerate(capture.frames, start=1):
+        b = spec.buses.get(c.bus)
+        if b is None:
+            raise UserError(located(shown, None, f"frame {no}: interface {c.bus!r} is not a bus of the spec "
+                                                 f"({', '.join(spec.buses)})"))
+        start = (c.time_ns - t0) * 1e-9
+        end = start + b.frame_time_us(len(c.data)) * 1e-6
+        heard = None if "lost" in c.flags else c.data
+        sent = c.sent if c.sent is not None else c.data
+        frames.append(TraceFrame(no, start, end, c.bus, c.sender, sent, heard, tuple(c.flags), _parse_or_none(sent),
+                                 _intact(heard)))
+    frames.sort(key=lambda f: (f.start, f.end, f.line))
+    return Trace(shown, frames, [])
+
+
+def read(path: str | Path, buses: set[str] | None = None, spec: Any = None) -> Trace:
+    """Read trace.tsv, or (given the spec) a pcapng capture; anything malformed is a one-line UserError
+    (`file:line: problem` for a trace)."""
     shown = str(path)
+    if spec is not None:
+        try:
+            with open(path, "rb") as fh:
+                magic = fh.read(4)
+        except OSError as exc:
+            raise UserError(located(shown, None, f"cannot read trace ({exc.strerror})")) from None
+        if magic == PCAPNG_MAGIC:
+            from captures.pcapng import read_file
+            return from_capture(read_file(path), spec, shown)
     try:
         text = Path(path).read_text()
     except (OSError, UnicodeDecodeError) as exc:

@@ -102,3 +102,36 @@ def test_new_fault_kinds_are_checked(tmp_path):
     p.write_text(base + "arbitration: {leg: seed}\n")
     with pytest.raises(UserError, match="unknown key 'leg'"):
         load_scenario(p, runner.load_spec_once())
+
+
+def test_a_runs_pcapng_checks_like_its_trace(saved, tmp_path):
+    """A capture (here the run's own bus.pcapng, exact clock) is validated like trace.tsv: same verdict, same
+    figures; a pcapng of a bus the spec does not have is a one-line error naming the file."""
+    from captures.pcapng import read_file, write_file
+
+    p = cli("trace", "check", str(saved / "bus.pcapng"), "--json")
+    t = cli("trace", "check", str(saved / "trace.tsv"), "--json")
+    assert p.returncode == t.returncode == 0, p.stdout + p.stderr
+    cap, tsv = json.loads(p.stdout), json.loads(t.stdout)
+    assert {k: cap[k] for k in ("violations", "requests", "served", "max_wait_slots")} == \
+        {k: tsv[k] for k in ("violations", "requests", "served", "max_wait_slots")}
+    assert cap["checked"]["id_req"] == tsv["checked"]["id_req"] > 0
+    capture = read_file(saved / "bus.pcapng")
+    frames = [f._replace(bus="nobus") if f.bus == "leg" else f for f in capture.frames]
+    interfaces = tuple(i._replace(name="nobus") if i.name == "leg" else i for i in capture.interfaces)
+    write_file(tmp_path / "bad.pcapng", interfaces, frames)
+    p = cli("trace", "check", str(tmp_path / "bad.pcapng"))
+    assert p.returncode == 1 and p.stderr.count("\n") == 1
+    assert p.stderr.startswith(f"{tmp_path / 'bad.pcapng'}: frame ") and "'nobus' is not a bus of the spec" in p.stderr
+
+
+def test_untimed_check_still_names_a_missing_retry(saved, tmp_path):
+    """--untimed (a capture without a true clock) keeps the rules that need none: a dropped ID_REQ retry."""
+    table = rows(saved / "trace.tsv")
+    reqs = [i for i, r in enumerate(table) if r[2] == "sensor" and r[6] == "ID_REQ" and r[5] == "PSC"]
+    del table[reqs[1]]
+    p = cli("trace", "check", str(write(tmp_path / "t.tsv", table)), "--untimed", "--json")
+    out = json.loads(p.stdout)
+    assert p.returncode == 1 and "id_retry" in out["by_rule"] and "bound_K" not in out["by_rule"]
+    assert "no reply to ID_REQ 1 of 2 to PSC" in out["first"]
+    assert "request_slot" not in out["checked"] and "one_talker" not in out["checked"]
