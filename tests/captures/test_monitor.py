@@ -29,8 +29,10 @@ GOOD = bytes.fromhex("042707010048c8")            # STATUS_ACK_RANGE, from the s
 
 def _cli_stdout(capsys, argv: list[str], want_rc: int) -> str:
     capsys.readouterr()
-    assert main(argv) == want_rc
-    return capsys.readouterr().out
+    rc = main(argv)
+    out = capsys.readouterr().out
+    assert rc == want_rc, out
+    return out
 
 
 def wait_for(predicate, timeout: float, what: str) -> None:
