@@ -9,8 +9,8 @@
            two-line LCD and the alerts on that terminal;
   RLC      takes part in POST only (no radio is simulated).
 
-The key table and the VT100 picture are the pure modules console.keymap and
-console.screen; the decisions (which record, when) are taken here.
+The key table and the VT100 picture are the pure modules behaviours.rcp_keys and
+behaviours.rcp_screen; the decisions (which record, when) are taken here.
 """
 from __future__ import annotations
 
@@ -28,8 +28,8 @@ from arachnae_proto.skeletons.uic_rcp import UicRcpSkeleton
 from behaviours import tuning as T
 from behaviours.runtime import Runtime
 from behaviours.speech import Speaker, write_wav
-from console.keymap import KeyDecoder, label_for_key, message_for_key
-from console.screen import Screen
+from behaviours.rcp_keys import KeyDecoder, label_for_key, message_for_key
+from behaviours.rcp_screen import Screen
 
 _MCP, _NP3 = ADDRESS_OF["MCP"], ADDRESS_OF["NP3"]
 _REDRAW = "\x0c"          # Ctrl-L: the terminal asks for the whole picture again
@@ -167,11 +167,11 @@ class UIC_RCP(_Records, Runtime, UicRcpSkeleton):
         self.every(T.UIC_KEY_POLL_S, self.poll_keys)
 
     def poll_keys(self) -> None:
-        for key in self.decoder.feed(self.hw.rcp_read()):   # escape sequences read whole (console.keymap)
+        for key in self.decoder.feed(self.hw.rcp_read()):   # escape sequences read whole (behaviours.rcp_keys)
             self.key(key)
 
     def key(self, key: str) -> None:
-        """seed 4.1: F=Forward, B=Backward, H=Halt, ... (console.keymap) -> a MOVE or POST_REQ record."""
+        """seed 4.1: F=Forward, B=Backward, H=Halt, ... (behaviours.rcp_keys) -> a MOVE or POST_REQ record."""
         if key == _REDRAW:
             self.hw.rcp_write(self.screen.full())
             return

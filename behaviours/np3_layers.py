@@ -1,4 +1,4 @@
-"""The NP3's subsumption network (SPEC-NOTES decision 8, seed 5.1-5.2, 6): its layers, tasks and wiring.
+"""The NP3's subsumption network (docs/decisions.md D8, seed 5.1-5.2, 6): its layers, tasks and wiring.
 
 Layers, lowest (strongest) first, as the issue orders them:
   - reflexes: contact (whisker or IR very close), pit (MMC NO_GROUND), dangerous

@@ -1,4 +1,4 @@
-"""POST (seed 6.3, SPEC-NOTES decisions 2 and 3): each master identifies its own
+"""POST (seed 6.3, docs/decisions.md D2, D3): each master identifies its own
 slaves with ID_REQ (bus response timeout, id_retries), asks each for its
 status, then asks its sub-masters for their POST_REPORT; the MCP turns the
 missing nodes into the verdict by the spec's declared rules.

@@ -1,4 +1,4 @@
-"""Brooks' subsumption architecture (seed reference [12], SPEC-NOTES decision 8) as a small library.
+"""Brooks' subsumption architecture (seed reference [12], docs/decisions.md D8) as a small library.
 
 Why explicit wiring instead of an if-chain: the seed wants fast reactions on
 low system levels that interrupt navigation (5.2) and a software that is easy

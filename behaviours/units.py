@@ -41,7 +41,7 @@ class Quantizer:
 
 
 def quantizer(message: type[Message], field: str) -> Quantizer:
-    """The saturating conversion of `message.field` (seed encodings, SPEC-NOTES decision 7)."""
+    """The saturating conversion of `message.field` (seed encodings, docs/decisions.md D7)."""
     info = next(f for f in message.FIELDS if f.name == field)
     conv = info.conv
     if isinstance(conv, LinearConv):

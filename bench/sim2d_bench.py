@@ -16,7 +16,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from codegen.model import load_spec  # noqa: E402
+from codegen.load import load_spec  # noqa: E402
 from sim2d.scenario import load_scenario  # noqa: E402
 from sim2d.sim import Simulation  # noqa: E402
 

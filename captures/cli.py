@@ -42,6 +42,12 @@ def register(sub: Any) -> None:
     rep.add_argument("--bus", help="which bus of the capture (needed when it holds several)")
     rep.set_defaults(func=cmd_replay)
 
+    dec = sub.add_parser("decode", help="decode a captured frame given in hex")
+    dec.add_argument("hex", nargs="+", help="frame bytes in hex; spaces and colons are ignored")
+    dec.add_argument("--own", default=None, metavar="ADDR",
+                     help="check the destination against this node address (0x21, 33 or a name such as LCP(1))")
+    dec.set_defaults(func=_decode)
+
 
 # -- shared checks --------------------------------------------------------------------------
 def _capture_path(src: str) -> Path:
@@ -90,7 +96,7 @@ def sigrok_command(vcd: Path, bus: Any) -> str:
 def cmd_vcd(args: argparse.Namespace) -> int:
     from captures.pcapng import read_file
     from captures.vcd import capture_vcd
-    from codegen.model import load_spec
+    from codegen.load import load_spec
 
     pcap = _capture_path(args.capture)
     spec = load_spec()
@@ -122,7 +128,7 @@ def _stop_on_signals() -> tuple[list[bool], dict]:
 def cmd_monitor(args: argparse.Namespace) -> int:
     from captures.decode import decode
     from captures.monitor import LiveTable, MonitorStats, Recorder, frames_from, plain_line
-    from codegen.model import load_spec
+    from codegen.load import load_spec
 
     spec = load_spec()
     bus = _spec_bus(spec, args.bus) if args.bus else next(iter(spec.buses.values()))
@@ -201,7 +207,7 @@ def cmd_monitor(args: argparse.Namespace) -> int:
 def cmd_replay(args: argparse.Namespace) -> int:
     from captures.pcapng import read_file
     from captures.replay import replay
-    from codegen.model import load_spec
+    from codegen.load import load_spec
 
     if not (args.speed > 0 and math.isfinite(args.speed)):
         raise UserError(f"--speed: expected a factor > 0, got {args.speed}")
@@ -223,3 +229,67 @@ def cmd_replay(args: argparse.Namespace) -> int:
         port.close()
     print(f"replayed {sent} frames of bus {bus.name} onto {args.port} in {time.monotonic() - started:.1f} s")
     return 0
+
+
+# -- decode: one frame given in hex ------------------------------------------------------------
+def _decode(args: argparse.Namespace) -> int:
+    text = "".join(args.hex).replace(":", "").replace(" ", "")
+    if text.lower().startswith("0x"):
+        text = text[2:]
+    try:
+        data = bytes.fromhex(text)
+    except ValueError:
+        raise UserError(f"decode: '{' '.join(args.hex)}' is not a hex string") from None
+    from arachnae_proto import CodecError, frame
+    from arachnae_proto.network import name_of
+
+    own = _node_address(args.own) if args.own is not None else None
+    try:
+        f = frame.parse(data, own)
+    except CodecError as err:
+        raise UserError(f"decode: {err.kind.name}: {err}") from None
+    _check_route(f)
+    m = f.message
+    print(f"{name_of(f.src)} -> {name_of(f.dst)}  {m.NAME} (opcode 0x{m.OPCODE:02X}, seed {m.SECTION})")
+    for info in m.FIELDS:
+        print(f"  {info.name:14} {info.describe(getattr(m, info.name))}")
+    sys.stdout.flush()
+    return 0
+
+
+def _node_address(text: str) -> int:
+    """--own: a node's address (0x21, 33) or short name (LCP(1)); broadcast and unknown addresses are refused."""
+    from arachnae_proto.network import ADDRESS_OF, NODE_ADDRESSES
+
+    if text in ADDRESS_OF:
+        return ADDRESS_OF[text]
+    try:
+        value = int(text, 0)
+    except ValueError:
+        raise UserError(f"decode: --own {text!r}: expected a node address such as 0x21 or a node name "
+                        "such as LCP(1) (`arachnae spec nodes` lists them)") from None
+    if value not in NODE_ADDRESSES:
+        raise UserError(f"decode: --own {text}: not a node address "
+                        "(`arachnae spec nodes` lists them)")
+    return value
+
+
+def _check_route(f: "object") -> None:
+    """seed 3.2.1: a frame comes from a node and goes to a node, or to broadcast only if its message may be
+    broadcast; the sender and receiver roles are the message's (spec messages.yaml from/to)."""
+    from arachnae_proto.network import BROADCAST, NODES
+
+    m = f.message
+    if f.src not in NODES:
+        raise UserError(f"decode: ADDRESS: source 0x{f.src:02X} is not a node address")
+    if f.dst == BROADCAST:
+        if not m.BROADCAST:
+            raise UserError(f"decode: ADDRESS: {m.NAME} to broadcast 0x{BROADCAST:02X}, but the spec does not "
+                            f"mark {m.NAME} broadcast")
+    elif f.dst not in NODES:
+        raise UserError(f"decode: ADDRESS: destination 0x{f.dst:02X} is not a node address")
+    sender, receiver = NODES[f.src], NODES.get(f.dst)
+    if sender[1] not in m.SENDERS:
+        raise UserError(f"decode: ROUTE: {m.NAME} from {sender[0]}, but only {', '.join(m.SENDERS)} send it")
+    if receiver is not None and receiver[1] not in m.RECEIVERS:
+        raise UserError(f"decode: ROUTE: {m.NAME} to {receiver[0]}, but only {', '.join(m.RECEIVERS)} receive it")

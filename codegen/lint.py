@@ -75,10 +75,15 @@ def _lint_text(path: Path, doc: Any, node: Any, where: list[Any], report: Report
 def _schema_check(path: Path, doc: Any, schema_name: str, report: Report) -> None:
     schema = yaml.safe_load((SCHEMA_DIR / schema_name).read_text())
     validator = _Validator(schema)
+    by_field: dict[tuple[str, ...], list[jsonschema.ValidationError]] = {}
     for err in sorted(validator.iter_errors(doc), key=lambda e: list(map(str, e.absolute_path))):
-        where = list(err.absolute_path)
+        by_field.setdefault(tuple(map(str, err.absolute_path)), []).append(err)
+    for errs in by_field.values():            # one line per field: its first problem, or all its missing keys
+        where = list(errs[0].absolute_path)
         field = ".".join(str(p) for p in where) or "(top level)"
-        report.add(path, doc, where, f"{field}: {_schema_message(err)}")
+        missing = [e.message.split(" is a required")[0] for e in errs if e.validator == "required"]
+        text = f"{', '.join(missing)} {'are' if len(missing) > 1 else 'is'} missing" if missing else _schema_message(errs[0])
+        report.add(path, doc, where, f"{field}: {text}")
 
 
 def _schema_message(err: jsonschema.ValidationError) -> str:

@@ -537,17 +537,5 @@ def spec_digest(paths: tuple[Path, ...]) -> str:
     return h.hexdigest()
 
 
-def load_spec(spec_dir: Path | str | None = None) -> Spec:
-    """Load, check and model the spec; raises arachnae.errors.UserError listing every problem."""
-    from codegen.lint import check_documents, check_targets  # late import: lint needs this module's types
-
-    directory = Path(spec_dir) if spec_dir is not None else SPEC_DIR
-    paths = tuple(directory / name for name in SPEC_FILES)
-    nodes_doc, messages_doc = check_documents(paths[0], paths[1])
-    spec = build(nodes_doc, messages_doc, paths, spec_digest(paths))
-    check_targets(spec, (paths[0], paths[1]), (nodes_doc, messages_doc))
-    return spec
-
-
 __all__ = ["ERROR_KINDS", "Spec", "Node", "Bus", "Message", "Field", "Enum", "Flags", "Frame", "Checksum", "PostRule", "PostRules", "Protocol",
-           "Quorum", "Reflex", "Requirement", "load_spec", "SPEC_DIR", "MILLI"]
+           "Quorum", "Reflex", "Requirement", "SPEC_DIR", "SPEC_FILES", "MILLI", "build", "spec_digest"]

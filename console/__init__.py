@@ -2,15 +2,11 @@
 
 "... über ein serielles Terminal oder ein anderes serielles VT100 kompatibles
 Endgerät mit einfachen Befehlen (F=Forward, B=Backward, H=Halt, usw)
-gesteuert" (seed 4.1). Three small parts:
-
-  keymap    key -> message (MOVE with a Mov_Cmd, or POST_REQ); the key table
-  screen    LCD lines, last command and alerts -> VT100 bytes
-  terminal  the host's end of the RS-232 line: a pty, the own terminal or a serial port
-
-keymap and screen are pure and used by the UIC/RCP node's firmware
-(behaviours.level0.UIC_RCP), which reads the keys and decides; the terminal
-module only carries bytes between a running simulation and the operator:
+gesteuert" (seed 4.1). The key table (behaviours.rcp_keys: key -> MOVE with a Mov_Cmd, or POST_REQ)
+and the VT100 picture (behaviours.rcp_screen: LCD lines, last command, alerts -> bytes) are the UIC/RCP
+node's own firmware logic, so they live in behaviours/ beside it (behaviours.level0.UIC_RCP). This
+package is only the host's end of the RS-232 line (`terminal`: a pty, the own terminal or a serial
+port), carrying bytes between a running simulation and the operator:
 
     arachnae sim run scenarios/console_drive.yaml --console pty        # prints /dev/pts/N
     arachnae sim run scenarios/console_drive.yaml --console stdio
@@ -20,8 +16,8 @@ module only carries bytes between a running simulation and the operator:
 """
 from __future__ import annotations
 
-from console.keymap import HELP, KEYMAP, KeyDecoder, label_for_key, message_for_key
-from console.screen import Screen
+from behaviours.rcp_keys import HELP, KEYMAP, KeyDecoder, label_for_key, message_for_key
+from behaviours.rcp_screen import Screen
 
 # console.terminal (termios, pyserial: host only) is imported where a line is opened, never by the firmware side
 __all__ = ["Screen", "KEYMAP", "HELP", "KeyDecoder", "message_for_key", "label_for_key"]

@@ -18,6 +18,9 @@
  * FW_IDLE_GAP_US after the last byte (timer interrupt). Defined in main.c. */
 void fw_rx_byte(uint8_t byte);
 void fw_rx_gap(void);
+/* Counters of main.c a debugger or a behaviour can read: frames for us, frames refused (any
+ * reason, also frames for other nodes), overruns, and corrupt frames heard (collisions). */
+extern volatile uint16_t fw_rx_frames, fw_rx_errors, fw_rx_overruns, fw_rx_corrupt;
 
 void hal_init(void);
 void hal_enable_interrupts(void);
@@ -37,6 +40,32 @@ uint8_t hal_echo_status(void);
 uint8_t hal_inputs(void);
 /* Test point / LED, pulsed when the behaviour detects a stimulus. */
 void hal_test_point(uint8_t on);
+
+/* Milliseconds since a byte was last on the line: received, or the end of our own frame
+ * (carrier sense before a slave-initiated frame, seed 3.2.2 "when the bus is idle"). */
+uint16_t hal_line_quiet_ms(void);
+
+/* The board's sensor front end (ADC, sonar timer, probe bus): one conversion of the
+ * kind below, `n` values in the reply field's raw steps (the transfer function of the
+ * front end is the spec's encoding of the XMIT_DATA_<role> field, behaviours.units),
+ * written to out[]. SAMPLE_SONAR: arg = head angle; out[0] = distance, out[1] = echo
+ * time in microseconds. */
+enum { HAL_SAMPLE_SONAR = 1, HAL_SAMPLE_IR = 2, HAL_SAMPLE_INCLINATION = 3, HAL_SAMPLE_TEMPERATURES = 4,
+       HAL_SAMPLE_LIGHT = 5, HAL_SAMPLE_BATTERY = 6 };
+void hal_sample(uint8_t kind, uint16_t arg, int16_t *out, uint8_t n);
+/* A debug-port event (what a Python node writes with hw.note): kind, one argument. */
+enum { HAL_NOTE_STIMULUS = 0x40, HAL_NOTE_ALARM = 0x41, HAL_NOTE_STATUS = 0x42 };
+enum { HAL_STIMULUS_WHISKER = 0, HAL_STIMULUS_IR = 1 };
+void hal_note(uint8_t kind, uint16_t arg);
+
+/* The debug record a debugger (or the SIL bridge) reads from RAM at the end of a run:
+ * the figures a Python sensor reports with debug_metrics(). Each behaviour fills the
+ * entries it has; firmware/sil_bridge.py reads the names from this enum. */
+enum fw_debug_index {
+    FW_DBG_ALARMS, FW_DBG_STATUS, FW_DBG_MEASUREMENTS, FW_DBG_SECOND_SETS,
+    FW_DBG_MEAN, FW_DBG_MEAN_MIN, FW_DBG_LEVEL_MIN, FW_DBG_COUNT
+};
+extern volatile int16_t fw_debug[FW_DBG_COUNT];
 
 /* Defined by the behaviour (nodes/<role>.c). */
 void fw_behaviour_init(void *node);

@@ -17,6 +17,15 @@ static FW_ROLE_NODE node;
 
 /* Counters a debugger or a test can read. */
 volatile uint16_t fw_rx_frames, fw_rx_errors, fw_rx_overruns;
+/* Frames heard corrupt (CRC, cut short, too long): a collision on the bus, whoever it was for. */
+volatile uint16_t fw_rx_corrupt;
+
+static void count_error(arachnae_status st)
+{
+    fw_rx_errors++;
+    if (st == ARACHNAE_CHECKSUM || st == ARACHNAE_TRUNCATED || st == ARACHNAE_OVERSIZE)
+        fw_rx_corrupt++;
+}
 
 /* RX interrupt context. */
 void fw_rx_byte(uint8_t byte)
@@ -27,7 +36,7 @@ void fw_rx_byte(uint8_t byte)
     if (st == ARACHNAE_NONE)
         return;
     if (st != ARACHNAE_OK) {
-        fw_rx_errors++;
+        count_error(st);
         return;
     }
     if (frame_ready) {              /* main loop still busy with the previous frame */
@@ -45,8 +54,9 @@ void fw_rx_byte(uint8_t byte)
 /* Timer interrupt context: the line was idle for FW_IDLE_GAP_US. */
 void fw_rx_gap(void)
 {
-    if (arachnae_parser_gap(&parser) != ARACHNAE_NONE)
-        fw_rx_errors++;  /* a frame cut short (TRUNCATED) */
+    arachnae_status st = arachnae_parser_gap(&parser);
+    if (st != ARACHNAE_NONE)
+        count_error(st);  /* a frame cut short (TRUNCATED) */
 }
 
 int main(void)

@@ -24,7 +24,7 @@ GEN_C = REPO / "generated" / "c"
 
 
 def _spec():
-    from codegen.model import load_spec
+    from codegen.load import load_spec
     return load_spec()
 
 
@@ -73,10 +73,14 @@ def role_config(spec, role: str) -> str:
             f"#define FW_BACKOFF_RANK {rank}u",
             f"#define FW_BACKOFF_SLOT_US {round(slot_us)}UL",
         ]
+        lines += slave_timing(spec, node, bus, rank, len(ranked), slot_us)
     else:
         lines += ["#define FW_BAUD 9600UL", "#define FW_BITS_PER_CHAR 10u", "#define FW_CHAR_US 1042UL",
                   "#define FW_TURNAROUND_US 500UL", "#define FW_IDLE_GAP_US 3646UL",
-                  "#define FW_MASTER_ADDRESS 0x00u", "#define FW_BACKOFF_RANK 0u", "#define FW_BACKOFF_SLOT_US 0UL"]
+                  "#define FW_MASTER_ADDRESS 0x00u", "#define FW_BACKOFF_RANK 0u", "#define FW_BACKOFF_SLOT_US 0UL",
+                  "#define FW_SLAVE_QUIET_US 0UL", "#define FW_BACKOFF_SCOPE_ALL 0u", "#define FW_BACKOFF_STEP_US 0UL",
+                  "#define FW_REQUESTERS 0u"]
+    lines += tuning(role) + alarm_limit(role)
     tx_max = spec.frame.overhead + max((m.max_size for m in spec.sends(role)), default=0)
     char_us = spec.buses[node.bus].char_time_us if node.bus else 1e6 * 10 / 9600
     low = role.lower()
@@ -95,6 +99,83 @@ def role_config(spec, role: str) -> str:
         f"#define FW_CD_WAIT_MS {math.ceil((2 * char_us + 2000) / 1000)}u",
         "#endif", ""]
     return "\n".join(lines)
+
+
+def slave_timing(spec, node, bus, rank: int, requesters: int, slot_us: float) -> list[str]:
+    """When a slave of `bus` may start a frame of its own (DATA_RDY): the rule of behaviours/runtime.py
+    (Runtime._slave_start, AfterReplies._slave_start, _backoff_wait) as numbers for the firmware."""
+    from behaviours.netconfig import NetConfig
+    net = NetConfig.from_spec(spec)
+    bit_us = 1e6 / bus.baud
+    gap_us = max(bus.turnaround_us, bus.idle_gap_us)
+    reflex_ranks = [i for i, a in enumerate(net.requesters.get(bus.name, ())) if net.reflex_from(a)]
+    is_reflex = net.reflex_from(node.address) is not None
+    # seed 5.2 / spec reflexes: an ordinary request leads the reflex source's by reflex_lead_bits, less the
+    # rank stagger it already has behind it (AfterReplies)
+    behind = rank - min(reflex_ranks) if reflex_ranks and not is_reflex else None
+    lead_us = 0.0 if behind is None else max(0, net.reflex_lead_bits - 2 * behind) * bit_us
+    quiet_us = bus.response_timeout_ms * 1000 + rank * 2 * bit_us + lead_us
+    defer_us = net.protocol.master_defer_slots * slot_us
+    if quiet_us >= defer_us:
+        # the plain rule of Runtime._slave_start: turnaround, plus the reflex lead for an ordinary request
+        quiet_us = bus.turnaround_us + (0.0 if not net.reflexes or is_reflex
+                                        else gap_us - bus.turnaround_us + net.reflex_lead_bits * bit_us)
+    scope_all = net.arbitration.get(bus.name) == "address_backoff" and net.backoff_scope == "all"
+    reflex = net.reflex_from(node.address)
+    interval = [] if reflex is None else [
+        "/* spec reflexes (seed 5.2): this node raises a reflex request at most this often */",
+        f"#define FW_REFLEX_MIN_INTERVAL_MS {math.ceil(reflex.min_interval_s * 1000)}u"]
+    return interval + [
+        "/* seed 3.2.2 'when the bus is idle': the line quiet this long before a DATA_RDY (behaviours/runtime.py) */",
+        f"#define FW_SLAVE_QUIET_US {math.ceil(quiet_us)}UL",
+        "/* spec address_backoff, scope all: after any corrupt frame, wait for our slot of the window */",
+        f"#define FW_BACKOFF_SCOPE_ALL {1 if scope_all else 0}u",
+        f"#define FW_BACKOFF_STEP_US {round(net.backoff_slots * slot_us)}UL",
+        f"#define FW_REQUESTERS {requesters}u",
+    ]
+
+
+# a sensor's SET_ALARM limit and the data field it is compared with (behaviours/sensors.py)
+ALARM_FIELDS = {"IRRC": ("SetAlarmIrrc", "XmitDataIrrc", "center"), "ISC": ("SetAlarmIsc", "XmitDataIsc", "longitudinal"),
+                "TSC": ("SetAlarmTsc", "XmitDataTsc", "temperature"), "LSC": ("SetAlarmLsc", "XmitDataLsc", "brightness"),
+                "PSC": ("SetAlarmPsc", "XmitDataPsc", "voltage")}
+
+
+def alarm_limit(role: str) -> list[str]:
+    """Whether the SET_ALARM limit's raw value IS the data field's raw value (behaviours.sensors.limit_in is the
+    identity over the limit's whole raw range): then the firmware compares it as it comes, without linking the
+    physical conversions (LSC: a log table); else it converts through the generated _to_milli/_from_milli."""
+    if role not in ALARM_FIELDS:
+        return []
+    from arachnae_proto import messages as M
+    from behaviours.sensors import limit_in
+    from behaviours.units import quantizer
+    alarm, data, field = ALARM_FIELDS[role]
+    info = next(f for f in getattr(M, alarm).FIELDS if f.name == "limit")
+    lo, hi = info.conv.lo, info.conv.hi
+    same = all(limit_in(quantizer(getattr(M, data), field), getattr(M, alarm), r) == r for r in range(lo, hi + 1))
+    return [f"/* SET_ALARM limit raw {lo}..{hi} equals the {field} raw value for every value (checked by roles.py) */",
+            f"#define FW_ALARM_LIMIT_IS_DATA_RAW {1 if same else 0}"]
+
+
+def tuning(role: str) -> list[str]:
+    """The behaviour's own numbers for this role (behaviours/tuning.py, CHOICE): seconds as milliseconds."""
+    from behaviours import tuning as T
+    out = ["/* behaviours/tuning.py (CHOICE, not protocol): the same numbers as the Python behaviour */"]
+    names = sorted(n for n in vars(T) if n.startswith(f"{role}_") or n.startswith("SENSOR_"))
+    for n in names:
+        v = getattr(T, n)
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            continue
+        if n.endswith("_S"):
+            out.append(f"#define TUNING_{n[:-2]}_MS {round(v * 1000)}u")
+        elif n.endswith("_M"):
+            out.append(f"#define TUNING_{n}M {round(v * 1000)}")
+        elif isinstance(v, int):
+            out.append(f"#define TUNING_{n} {v}")
+    if role in T.ALARM_REARM_RAW:
+        out.append(f"#define TUNING_ALARM_REARM_RAW {T.ALARM_REARM_RAW[role]}")
+    return out
 
 
 _PROTO = re.compile(r"^(void|arachnae_status)\s+(\w+)\((.*)\);$")

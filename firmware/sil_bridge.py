@@ -21,15 +21,26 @@ bus at the time of its first byte, or at the latest one sync period later. When
 the bus reports an echo that differs from the frame, the bridge sets the
 collision-detect latch (PC2) the firmware reads FW_CD_WAIT_MS after the frame;
 the next DE rising edge clears it, as the latch on the board does.
+
+Sensors: the firmware asks its sensor front end (hal.h hal_sample, GPIOR0..2 in
+simavr) for a conversion; the bridge reads the simulated world through the node's
+hardware (sim2d.hardware: sonar_ping, ir_ranges, ...) and answers in the XMIT_DATA
+field's raw steps, quantised by behaviours.units as the Python sensors do. The
+firmware's debug-port notes (hal_note) become hw.note events, and its debug record
+(fw_debug in RAM) is what debug_metrics() reports, as a Python node's would.
 """
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import weakref
+from functools import lru_cache
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, NamedTuple
 
+
+from arachnae_proto.enums import RangeStatus
 
 FIRMWARE = Path(__file__).resolve().parent
 BUILD = FIRMWARE / "build"
@@ -40,6 +51,37 @@ DE_PIN = "D2"             # RS-485 driver enable (avr/hal_avr.c)
 TEST_POINT = "B5"         # pulsed by the firmware when it detects a stimulus
 INPUT_PINS = ("C0", "C1")  # sensor switches, active low (avr/hal_avr.c)
 CD_PIN = "C2"             # collision-detect latch, set on a corrupt echo
+
+AVR_DATA = 0x800000       # avr-gcc's offset of data-space symbols
+
+
+@lru_cache(maxsize=None)
+def hal_enum(prefix: str) -> dict[str, int]:
+    """Values of hal.h's enum constants named PREFIX* (one definition, shared with the firmware)."""
+    text = (FIRMWARE / "hal.h").read_text()
+    out: dict[str, int] = {}
+    for body in re.findall(r"enum(?:\s+\w+)?\s*\{([^}]*)\}", text):
+        value = -1
+        for item in body.split(","):
+            m = re.match(r"\s*(\w+)\s*(?:=\s*(0x[0-9A-Fa-f]+|\d+))?\s*$", item)
+            if not m:
+                continue
+            value = int(m.group(2), 0) if m.group(2) else value + 1
+            if m.group(1).startswith(prefix):
+                out[m.group(1)[len(prefix):]] = value
+    return out
+
+
+@lru_cache(maxsize=None)
+def symbol_address(elf: Path, name: str) -> tuple[int, int]:
+    """(data-space address, size) of a RAM symbol of the firmware (avr-nm)."""
+    out = subprocess.run(["avr-nm", "-S", str(elf)], capture_output=True, text=True, check=True).stdout
+    for line in out.splitlines():
+        parts = line.split()
+        if len(parts) == 4 and parts[3] == name:
+            return int(parts[0], 16) - AVR_DATA, int(parts[1], 16)
+    raise SilError(f"{elf}: no symbol {name}")
+
 
 # Roles with hand-written firmware behaviour (firmware/nodes/<role>.c), i.e. what --sil accepts.
 SIL_ROLES = tuple(sorted(p.stem.upper() for p in (FIRMWARE / "nodes").glob("*.c")))
@@ -100,6 +142,10 @@ class SilHost:
                 events.append(("p", int(rest[0]), rest[1], int(rest[2])))
             elif kind == "m":
                 events.append(("m", int(rest[0]), int(rest[1])))
+            elif kind == "a":
+                events.append(("a", int(rest[0]), int(rest[1]), int(rest[2])))
+            elif kind == "d":
+                events.append(("d", bytes(int(b, 16) for b in rest)))
             elif kind == "x":
                 raise SilError(f"the AVR stopped at cycle {rest[0]} (simavr state {rest[1]})")
             else:
@@ -120,6 +166,15 @@ class SilHost:
 
     def set_pin(self, pin: str, value: int) -> None:
         self._command(f"s {pin} {1 if value else 0}")
+
+    def reply(self, values: list[int]) -> None:
+        """What the firmware reads next from its sensor port: 16-bit values, little-endian."""
+        data = b"".join((v & 0xFFFF).to_bytes(2, "little") for v in values)
+        self._command("v " + " ".join(f"{b:02x}" for b in data))
+
+    def read_ram(self, address: int, size: int) -> bytes:
+        (_, data), = self._command(f"d {address} {size}")
+        return data
 
     def stack_used(self) -> int:
         """Deepest stack use so far, bytes (RAMEND - lowest SP)."""
@@ -216,13 +271,71 @@ class SilNode:
                 self._event(ev)
 
     def _event(self, ev: tuple) -> None:
-        if ev[0] == "t":
+        if ev[0] == "a":
+            self._port(ev[2], ev[3])
+        elif ev[0] == "t":
             self._transmit(ev[1], ev[2])
         elif ev[0] == "p" and ev[2] == DE_PIN and ev[3] == 1:
             self.host.set_pin(CD_PIN, 0)
         elif ev[0] == "p" and ev[2] == TEST_POINT and ev[3] == 1:
             self.stimuli += 1
             self.hw.note("stimulus", kind="whisker")
+
+    # -- sensor front end and debug port (hal.h) ----------------------------------
+    def _port(self, code: int, arg: int) -> None:
+        sample, note = hal_enum("HAL_SAMPLE_"), hal_enum("HAL_NOTE_")
+        if code in sample.values():
+            self.host.reply(self._sample(next(k for k, v in sample.items() if v == code), arg))
+        elif code == note["STIMULUS"]:
+            kinds = {v: k.lower() for k, v in hal_enum("HAL_STIMULUS_").items()}
+            self.stimuli += 1
+            self.hw.note("stimulus", kind=kinds.get(arg, str(arg)))
+        elif code == note["ALARM"]:
+            self.hw.note("sensor_alarm", node=self.node.short, channels=[c for c in range(16) if arg >> c & 1])
+        elif code == note["STATUS"]:
+            self.hw.note("sensor_status", node=self.node.short, status=RangeStatus(arg).name)
+        else:
+            raise SilError(f"{self.node.short}: unknown sensor port request {code:#04x}")
+
+    def _sample(self, kind: str, arg: int) -> list[int]:
+        """One conversion of the front end, in the reply field's raw steps (behaviours.units)."""
+        q, hw = _quantizers(), self.hw
+        if kind == "SONAR":
+            metres, dt = hw.sonar_ping(arg)
+            return [q["us"].hi if metres is None else q["us"].raw(metres), min(0xFFFF, round(dt * 1e6))]
+        if kind == "IR":
+            return [q["ir"].hi if m is None else q["ir"].raw(m * 100) for m in hw.ir_ranges()]
+        if kind == "INCLINATION":
+            return [q["isc"].raw(a) for a in hw.inclination()]
+        if kind == "TEMPERATURES":
+            temps = hw.temperatures()
+            return [len(temps)] + [q["tsc"].raw(c) for c in temps]
+        if kind == "LIGHT":
+            return [q["lsc"].raw(hw.light())]
+        if kind == "BATTERY":
+            return [q["psc"].raw(hw.battery())]
+        raise SilError(f"{self.node.short}: no front end for {kind}")
+
+    def debug_metrics(self) -> dict:
+        """The firmware's debug record (hal.h fw_debug), named as behaviours/sensors.py names them."""
+        role = self.node.role
+        if role == "TPSC":
+            return {}
+        address, size = symbol_address(self.elf, "fw_debug")
+        raw = self.host.read_ram(address, size)
+        names = hal_enum("FW_DBG_")
+        dbg = {k.lower(): int.from_bytes(raw[2 * v:2 * v + 2], "little", signed=True)
+               for k, v in names.items() if k != "COUNT"}
+        out: dict[str, Any] = {"alarms": dbg["alarms"]}
+        if role in ("USRC", "IRRC"):
+            out.update(status=RangeStatus(dbg["status"]).name, measurements=dbg["measurements"],
+                       second_sets=dbg["second_sets"])
+        if role == "PSC":
+            volts = _quantizers()["psc"].phys
+            measured = dbg["mean"] != 0          # raw 0 is outside the voltage field's range: no measurement yet
+            out.update({k: round(volts(dbg[n]), 3) if measured else None
+                        for k, n in (("mean_v", "mean"), ("mean_min_v", "mean_min"), ("level_min_v", "level_min"))})
+        return out
 
     def _transmit(self, first_cycle: int, first: int) -> None:
         """The firmware started a frame: run it, without input, until it releases the line."""
@@ -247,17 +360,71 @@ class SilNode:
         self.hw.after(delay, self.transmit, self.bus_name, bytes(frame))
 
 
-def sil_factory(elf: Path | str | None = None) -> Callable[..., SilNode]:
+@lru_cache(maxsize=None)
+def _quantizers() -> dict[str, Any]:
+    """The sensors' field conversions (behaviours.units), the front end's transfer functions."""
+    from arachnae_proto import messages as M
+    from behaviours.units import quantizer
+    return {"us": quantizer(M.XmitDataUsrc, "distance"), "ir": quantizer(M.XmitDataIrrc, "center"),
+            "isc": quantizer(M.XmitDataIsc, "longitudinal"), "tsc": quantizer(M.XmitDataTsc, "temperature"),
+            "lsc": quantizer(M.XmitDataLsc, "brightness"), "psc": quantizer(M.XmitDataPsc, "voltage")}
+
+
+def sil_factory(elf: Path | str | None = None, made: list[SilNode] | None = None) -> Callable[..., SilNode]:
     """What sim2d.sim calls instead of behaviour_class(role) for a node run as firmware:
-    factory(address, hw.transmit, hw, config)."""
+    factory(address, hw.transmit, hw, config); each node made is appended to `made`."""
     def make(address: int, transmit: Callable[[str, bytes], None], hw: Any, config: Any = None) -> SilNode:
-        return SilNode(address, transmit, hw, config, elf)
+        node = SilNode(address, transmit, hw, config, elf)
+        if made is not None:
+            made.append(node)
+        return node
     return make
+
+
+class RamUse(NamedTuple):
+    """simavr's high-water mark of one SIL node's RAM: static data plus the deepest stack seen."""
+    node: str
+    static: int           # .data + .bss bytes (avr-size)
+    stack: int            # RAMEND - lowest SP during the run
+    ram: int              # the MCU's SRAM bytes
+
+
+def static_ram(elf: Path) -> int:
+    out = subprocess.run(["avr-size", "-A", str(elf)], capture_output=True, text=True, check=True).stdout
+    return sum(int(line.split()[1]) for line in out.splitlines() if line.split()[:1] in ([".data"], [".bss"]))
+
+
+RAM_BYTES = 2048          # ATmega328P SRAM (the SIL target, avr/hal_avr.c)
+
+
+def ram_use(nodes: list[SilNode]) -> list[RamUse]:
+    """Per SIL node, at the end of a run (its simavr process must still be running)."""
+    return [RamUse(n.node.short, static_ram(n.elf), n.host.stack_used(), RAM_BYTES) for n in nodes]
+
+
+def ram_lines(uses: list[RamUse]) -> list[str]:
+    out = ["node   static  stack  high-water  of SRAM"]
+    for u in uses:
+        out.append(f"{u.node:<6} {u.static:>6} {u.stack:>6} {u.static + u.stack:>11}  {u.ram}")
+    return out
+
+
+def sil_names(args: list[str]) -> list[str]:
+    """--sil values: repeated and/or comma lists (USRC,TPSC,IRRC), in order, each once."""
+    out: list[str] = []
+    for arg in args:
+        for name in re.split(r",(?![^()]*\))", arg):      # JAC(1,1) keeps its comma
+            name = name.strip()
+            if name and name not in out:
+                out.append(name)
+    return out
 
 
 def check_sil_nodes(spec: Any, names: list[str]) -> None:
     """One-line errors for --sil arguments (arachnae.errors.UserError)."""
     from arachnae.errors import UserError
+    if not names:
+        raise UserError("--sil: no node given (e.g. --sil TPSC or --sil USRC,TPSC,IRRC)")
     for name in names:
         node = next((n for n in spec.nodes if n.short == name), None)
         if node is None:
@@ -268,41 +435,3 @@ def check_sil_nodes(spec: Any, names: list[str]) -> None:
                if not p.exists()]
     if missing:
         raise UserError(f"--sil: {os.path.relpath(missing[0])} is not built; run `make firmware`")
-
-
-def run_scenario(path: str, sil: tuple[str, ...], seed: int | None = None, spec: Any = None):
-    """sim2d.runner.run with the nodes in `sil` run as firmware (what `arachnae sim run --sil` does)."""
-    from sim2d import runner
-    spec = spec or runner.load_spec_once()
-    check_sil_nodes(spec, list(sil))
-    return runner.run(path, seed, spec=spec, replace_nodes={name: sil_factory() for name in sil})
-
-
-def main(argv: list[str] | None = None) -> int:
-    """python -m firmware.sil_bridge SCENARIO --sil NODE [--seed N]: one SIL run, its metrics."""
-    import argparse
-    import sys
-
-    from arachnae.errors import UserError
-    ap = argparse.ArgumentParser(prog="python -m firmware.sil_bridge", description=main.__doc__)
-    ap.add_argument("scenario")
-    ap.add_argument("--sil", action="append", required=True, help="node run as firmware (repeatable)")
-    ap.add_argument("--seed", type=int)
-    args = ap.parse_args(argv)
-    try:
-        if not Path(args.scenario).is_file():
-            raise UserError(f"{args.scenario}: no such scenario file")
-        out = run_scenario(args.scenario, tuple(args.sil), args.seed)
-    except (UserError, SilError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 1
-    m = out.result.metrics
-    print(f"{out.scenario.name} seed {out.scenario.seed} with {', '.join(args.sil)} in simavr: "
-          f"POST {m['post']['verdict']}, frames {m['frames']}, collisions {m['collisions']}")
-    for name, ok, detail in out.expectations:
-        print(f"  {'PASS' if ok else 'FAIL'} {name}: {detail}")
-    return 1 if out.failed else 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -6,10 +6,15 @@ they count only what --gc-sections kept, split by where it came from:
     skeleton   generated/c node_<role>.c
     firmware   main.c, the board HAL and the behaviour (or an empty stub)
     runtime    C start-up, libgcc, libc, vector table
-Stack: worst case over the static call graph (objdump calls + -fstack-usage frames);
-the parser's one indirect call is resolved to the role's payload check.
+Stack: worst case over the static call graph (objdump calls + -fstack-usage frames, plus
+the return address each call pushes), deepest path first; the parser's one indirect call is
+resolved to the role's payload check. parse = the RX interrupt's parser path, dispatch = the
+skeleton without the behaviour, node = main with all it calls plus the deepest interrupt.
+Issue 15: the budgets (a sensor role in 1 KiB, any role in 2 KiB, the TPSC within 1.5x of the
+hand-written baseline) and, with --nanopb, nanopb's codec bytes for the same roles beside ours.
 Writes build/size.json; prints the tables. Exit 1 if the codec has data or bss of
-its own or an image could not be analysed.
+its own or an image could not be analysed (a budget overrun is reported, tests/firmware
+test_size.py holds the limits).
 """
 from __future__ import annotations
 
@@ -23,7 +28,9 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 SENSOR_ROLES = ("usrc", "tpsc", "irrc", "isc", "tsc", "lsc", "psc")
-AVR_FLASH_BUDGET = 2048          # issue 6: codec + skeleton of one sensor role in 2 KiB of AVR flash
+AVR_FLASH_BUDGET = 2048          # issue 6: codec + skeleton of any role in 2 KiB of AVR flash
+SENSOR_FLASH_BUDGET = 1024       # issue 15: a sensor role's codec + skeleton in 1 KiB
+TPSC_BASELINE_RATIO = 1.5        # issue 15: the TPSC within 1.5x of the hand-written baseline
 TOOLS = {"avr": ("avr-objdump", 2), "m0": ("arm-none-eabi-objdump", 0)}   # objdump, bytes a call pushes
 
 FLASH_SECTIONS = (".text", ".rodata", ".progmem", ".isr_vector", ".vectors", ".init", ".fini", ".trampolines", ".ctors", ".dtors", ".jumptables")
@@ -50,6 +57,7 @@ class Image:
     parts: dict[str, Part] = field(default_factory=lambda: {k: Part() for k in ("codec", "skeleton", "firmware", "runtime")})
     stack: dict[str, int] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    messages: Part = field(default_factory=Part)     # the codec's msg_*.o only (per-message code)
 
     @property
     def total(self) -> Part:
@@ -61,6 +69,8 @@ class Image:
 
 def category(obj: str, role: str) -> str:
     name = Path(obj).name
+    if "/nanopb/" in obj:        # nanopb runtime and the role's .pb.c; the driver is the firmware
+        return "firmware" if name.startswith("npb_") else "codec"
     if "/gen/" in obj:
         return "skeleton" if name == f"node_{role}.o" else "codec"
     if "/baseline/" in obj:      # the hand-written protocol code stands in for codec + skeleton
@@ -111,6 +121,8 @@ def parse_map(path: Path, image: Image) -> None:
         if kind is None or size == 0 or sec.startswith("*"):
             continue
         image.parts[category(obj, image.role)].add(kind, size)
+        if "/gen/" in obj and Path(obj).name.startswith("msg_"):
+            image.messages.add(kind, size)
 
 
 # ---- stack --------------------------------------------------------------------------
@@ -238,34 +250,80 @@ def table(images: list[Image], target: str) -> list[str]:
     return rows
 
 
+def load_nanopb(build: Path, roles: list[str]) -> list[Image]:
+    """nanopb's codec of the same roles (make -C firmware nanopb): runtime + generated .pb.c."""
+    images = []
+    for role in roles:
+        mp = build / "avr" / f"nanopb_{role}.map"
+        if not mp.exists():
+            raise SystemExit(f"size_report: {mp} missing; run `make -C firmware nanopb` first")
+        img = Image(role, "avr")
+        parse_map(mp, img)
+        images.append(img)
+    return images
+
+
+def codec_skel(img: Image) -> int:
+    return img.parts["codec"].flash + img.parts["skeleton"].flash
+
+
+def budgets(images: list[Image], failures: list[str]) -> list[str]:
+    out = ["", f"== budget (issue 15): codec + skeleton in AVR flash, a sensor role <= {SENSOR_FLASH_BUDGET}, "
+           f"any role <= {AVR_FLASH_BUDGET}; the codec has no data or bss"]
+    for img in images:
+        c = img.parts["codec"]
+        if (c.data or c.bss) and img.role != "baseline_tpsc":
+            failures.append(f"{img.target} {img.role}: the codec has {c.data} bytes of data and {c.bss} of bss")
+        if img.target == "avr" and img.role != "baseline_tpsc":
+            used = codec_skel(img)
+            limit = SENSOR_FLASH_BUDGET if img.role in SENSOR_ROLES else AVR_FLASH_BUDGET
+            verdict = "fits" if used <= limit else f"OVER by {used - limit}"
+            out.append(f"  {img.role:8} {used:5} bytes of {limit}: {verdict}")
+    return out
+
+
+def comparison(images: list[Image], nanopb: list[Image]) -> list[str]:
+    """Ours beside the hand-written baseline and nanopb, per role (AVR)."""
+    base = next(i for i in images if i.target == "avr" and i.role == "baseline_tpsc")
+    baselines = {"tpsc": codec_skel(base)}
+    npb = {i.role: i.parts["codec"].flash for i in nanopb}
+    head = (f"{'role':8} {'ours codec+skel':>15} {'ours msg_*.c':>12} {'baseline':>9} {'ours/baseline':>13} "
+            f"{'nanopb codec':>12} {'nanopb/ours':>11}")
+    out = ["", "== AVR codec bytes: generated (ours) vs hand-written baseline (firmware/baseline/) vs nanopb "
+           "(firmware/nanopb/, runtime + descriptors; no framing, CRC, parser, dispatch or range checks)",
+           head, "-" * len(head)]
+    for img in images:
+        if img.target != "avr" or img.role == "baseline_tpsc":
+            continue
+        ours = codec_skel(img)
+        b, n = baselines.get(img.role), npb.get(img.role)
+        ratio = f"{ours / b:.2f}x" if b else "-"
+        nratio = f"{n / ours:.2f}x" if n else "-"
+        out.append(f"{img.role:8} {ours:>15} {img.messages.flash:>12} {b if b else '-':>9} {ratio:>13} "
+                   f"{n if n else '-':>12} {nratio:>11}")
+    gen = next(i for i in images if i.target == "avr" and i.role == "tpsc")
+    out += [f"  TPSC bar: ours <= {TPSC_BASELINE_RATIO} x baseline = {int(TPSC_BASELINE_RATIO * baselines['tpsc'])} bytes; "
+            f"images: generated {gen.total.flash} bytes flash, {gen.total.data + gen.total.bss} RAM; "
+            f"baseline {base.total.flash} bytes flash, {base.total.data + base.total.bss} RAM"]
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--build", default=str(HERE / "build"), help="firmware build folder")
+    ap.add_argument("--nanopb", default="", help="roles with a nanopb build to compare with (space separated)")
     args = ap.parse_args(argv)
     build = Path(args.build)
     images = load_images(build)
+    nanopb = load_nanopb(build, args.nanopb.split())
     failures: list[str] = []
     out: list[str] = []
     for target, name in (("avr", "AVR ATmega328P, avr-gcc -Os"), ("m0", "Cortex-M0, arm-none-eabi-gcc -Os")):
-        out += ["", f"== {name}: bytes (t/d/b = text/data/bss; stack in bytes, worst case of the static call graph)"]
+        out += ["", f"== {name}: bytes (t/d/b = text/data/bss; stack in bytes, worst case of the static call graph:"
+                f" parse = RX interrupt path, dispatch = skeleton without the behaviour, node = main + deepest ISR)"]
         out += table(images, target)
-    out += ["", f"== budget: codec + skeleton of a sensor role in {AVR_FLASH_BUDGET} bytes of AVR flash, codec without data or bss"]
-    for img in images:
-        c, s = img.parts["codec"], img.parts["skeleton"]
-        if (c.data or c.bss) and img.role != "baseline_tpsc":
-            failures.append(f"{img.target} {img.role}: the codec has {c.data} bytes of data and {c.bss} of bss")
-        if img.target == "avr" and img.role in SENSOR_ROLES:
-            used = c.flash + s.flash
-            verdict = "fits" if used <= AVR_FLASH_BUDGET else f"OVER by {used - AVR_FLASH_BUDGET}"
-            out.append(f"  {img.role:6} {used:5} bytes: {verdict} ({AVR_FLASH_BUDGET - used:+d} left)")
-    base = next(i for i in images if i.target == "avr" and i.role == "baseline_tpsc")
-    gen = next(i for i in images if i.target == "avr" and i.role == "tpsc")
-    gb = gen.parts["codec"].flash + gen.parts["skeleton"].flash
-    out += ["", "== TPSC on AVR: generated codec + skeleton vs the hand-written baseline (firmware/baseline/)",
-            f"  generated codec+skeleton {gb} bytes; generated image {gen.total.flash} bytes flash, {gen.total.data + gen.total.bss} RAM",
-            f"  baseline protocol code (baseline/tpsc_proto.c) {base.parts['codec'].flash} bytes flash, "
-            f"{base.parts['codec'].bss} bss; baseline image {base.total.flash} bytes flash, {base.total.data + base.total.bss} RAM",
-            f"  image difference: {gen.total.flash - base.total.flash:+d} bytes flash for the generated version"]
+    out += budgets(images, failures)
+    out += comparison(images, nanopb)
     for img in images:
         for n in img.notes:
             out.append(f"  note {img.target} {img.role}: {n}")
@@ -273,8 +331,9 @@ def main(argv: list[str] | None = None) -> int:
                 failures.append(f"{img.target} {img.role}: {n}")
     print("\n".join(out))
     (build / "size.json").write_text(json.dumps(
-        [{"role": i.role, "target": i.target, "stack": i.stack, "notes": i.notes,
-          **{k: vars(p) for k, p in i.parts.items()}} for i in images], indent=1) + "\n")
+        [{"role": i.role, "target": i.target, "stack": i.stack, "notes": i.notes, "messages": vars(i.messages),
+          **{k: vars(p) for k, p in i.parts.items()}} for i in images]
+        + [{"role": i.role, "target": "avr-nanopb", "codec": vars(i.parts["codec"])} for i in nanopb], indent=1) + "\n")
     for f in failures:
         print(f"size_report: {f}", file=sys.stderr)
     return 1 if failures else 0

@@ -22,10 +22,10 @@ def build_models(name: str, spec, variant: str = "spec", bus: str | None = None,
                 + build_models("post", spec, legs=legs, symmetry=symmetry)
                 + build_models("reaction", spec, size=size))
     if name == "arbitration":
-        buses = [bus] if bus else [b for b, x in spec.buses.items() if x.arbitration != "polled"]
+        buses = [bus] if bus else spec_adapter.contended_buses(spec)
         return [arbitration.build(spec_adapter.arbitration(spec, b, scope), variant, size) for b in buses]
     if name == "id_retry":
-        buses = [bus] if bus else ["first", "sensor"] if "sensor" in spec.buses else [next(iter(spec.buses))]
+        buses = [bus] if bus else spec_adapter.contended_buses(spec)
         return [id_retry.build(spec_adapter.identification(spec, b), size) for b in buses]
     if name == "post":
         return [post.build(spec_adapter.post(spec), legs, symmetry)]

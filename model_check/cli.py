@@ -87,11 +87,11 @@ def _slave_counts(spec, model: str, bus: str | None, spec_adapter) -> dict[str, 
     model_check.checks.build_models picks)."""
     counts: dict[str, int] = {}
     if model in ("arbitration", "all"):
-        buses = [bus] if bus else [b for b, x in spec.buses.items() if x.arbitration != "polled"]
+        buses = [bus] if bus else spec_adapter.contended_buses(spec)
         for b in buses:
             counts[f"{b} (arbitration)"] = len(spec_adapter.arbitration(spec, b).slaves)
     if model in ("id_retry", "all"):
-        buses = [bus] if bus else ["first", "sensor"] if "sensor" in spec.buses else [next(iter(spec.buses))]
+        buses = [bus] if bus else spec_adapter.contended_buses(spec)
         for b in buses:
             counts[f"{b} (id_retry)"] = len(spec_adapter.identification(spec, b).slaves)
     return counts

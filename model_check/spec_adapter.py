@@ -21,16 +21,59 @@ MISSING_FIELDS = [
 
 def load(spec_dir: str | None = None):
     try:
-        from codegen.model import load_spec
+        from codegen.load import load_spec
     except ImportError as exc:  # pragma: no cover - the lead's loader is part of the repo
         raise UserError(f"cannot load the spec model: {exc}") from None
     return load_spec(spec_dir)
 
 
+def need_message(spec, name: str):
+    """The spec's message `name`, which the models use by its seed name; a spec that renamed or dropped it
+    gets a one-line error naming the file instead of a KeyError deep in a model."""
+    try:
+        return spec.message(name)
+    except KeyError:
+        raise UserError(f"{spec.sources[-1]}: the model checker needs message {name!r} (the seed's name for it), "
+                        f"which this spec does not declare") from None
+
+
+def need_bus(spec, name: str):
+    """The spec's bus `name` (see need_message)."""
+    try:
+        return spec.buses[name]
+    except KeyError:
+        raise UserError(f"{spec.sources[0]}: the model checker needs a bus {name!r}, which this spec does not "
+                        f"declare; buses: {', '.join(spec.buses)}") from None
+
+
+def contended_buses(spec) -> list[str]:
+    """The buses whose slaves start frames on their own (every arbitration but `polled`), in spec order: the
+    buses the arbitration and id_retry models check by default (seed 3.2.2)."""
+    return [name for name, bus in spec.buses.items() if bus.arbitration != "polled"] or [next(iter(spec.buses))]
+
+
+def receiver_of(spec, message: str):
+    """The first node that receives `message` and is a bus slave: where the models find the bus a seed
+    message travels on (HEAD_STEP: the USRC on the sensor bus)."""
+    roles = need_message(spec, message).receivers
+    node = next((n for n in spec.nodes if n.role in roles and n.bus is not None), None)
+    if node is None:
+        raise UserError(f"{spec.sources[-1]}: message {message!r} goes to no bus slave")
+    return node
+
+
+def data_record(spec, role: str):
+    """The XMIT_DATA form a sensor role answers with (seed 3.2.11: XMIT_DATA in each node's encoding)."""
+    record = next((m for m in spec.messages if m.senders == (role,) and m.seed_name == "XMIT_DATA"), None)
+    if record is None:
+        raise UserError(f"{spec.sources[-1]}: no XMIT_DATA form (seed_name XMIT_DATA) sent by {role}")
+    return record
+
+
 def frame_us(spec, bus: str, message: str) -> float:
     """Wire time of the longest frame of `message` on `bus`, plus the frame gap before it (spec buses)."""
-    m = spec.message(message)
-    b = spec.buses[bus]
+    m = need_message(spec, message)
+    b = need_bus(spec, bus)
     return spec.frame_time_us(bus, m.max_size) + b.frame_gap_us
 
 
@@ -44,7 +87,7 @@ def response_window_us(spec, bus: str) -> float:
     spec says so (protocol.response_timeout_to), then for the rest of the longest ID_ACK."""
     window = first_byte_timeout_us(spec, bus)
     if spec.protocol.response_timeout_to == "first_byte":
-        window += spec.frame_time_us(bus, spec.message("ID_ACK").max_size)
+        window += spec.frame_time_us(bus, need_message(spec, "ID_ACK").max_size)
     return window
 
 
@@ -101,9 +144,7 @@ def record_route(spec, bus: str, slave) -> tuple[list[str], list[str], str]:
                    if role in m.senders and m.receivers == (master.role,) and m.name in ("XMIT_RECORD", "MOVE")),
                   None)
     if record is None:
-        record = next((m for m in spec.messages if m.senders == (role,) and m.seed_name == "XMIT_DATA"), None)
-    if record is None:
-        raise UserError(f"bus {bus}: no record message for {slave.short}")
+        record = data_record(spec, role)
     fetch.append(record.name)
     if record.name != "XMIT_DATA" and record.seed_name != "XMIT_DATA":
         relayed = spec.message(record.relayed_as or "DATA")   # spec messages.<record>.relayed_as

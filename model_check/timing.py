@@ -84,7 +84,9 @@ def scan_duration(spec, measurements: int = 3, step_deg: int = 1, range_m: float
     per reading (6.2)."""
     steps = math.ceil(360 / step_deg)
     echo = 2 * range_m / SPEED_OF_SOUND
-    frames_us = sum(sa.frame_us(spec, "sensor", m) for m in ("HEAD_STEP", "DO_MEASURE", "XMIT_DATA", "XMIT_DATA_USRC"))
+    sonar = sa.receiver_of(spec, "HEAD_STEP")     # seed 3.2.11: the USRC turns the head and measures
+    frames_us = sum(sa.frame_us(spec, sonar.bus, m)
+                    for m in ("HEAD_STEP", "DO_MEASURE", "XMIT_DATA", sa.data_record(spec, sonar.role).name))
     per_step = measurements * echo + frames_us / 1e6
     total = steps * per_step
     parts = [f"{steps} steps x ({measurements} x {echo * 1000:.1f} ms echo at {range_m:g} m "
@@ -109,7 +111,7 @@ def id_timeout_check(spec) -> list[str]:
     out = []
     first_byte = spec.protocol.response_timeout_to == "first_byte"
     for b in spec.buses.values():
-        ack_ms = spec.frame_time_us(b.name, spec.message("ID_ACK").max_size) / 1000
+        ack_ms = spec.frame_time_us(b.name, sa.need_message(spec, "ID_ACK").max_size) / 1000
         earliest_ms = b.frame_gap_us / 1000 + (0 if first_byte else ack_ms)
         if earliest_ms > b.response_timeout_ms:
             out.append(f"bus {b.name}: a reply cannot {'start' if first_byte else 'end'} before {earliest_ms:.1f} ms at "

@@ -25,7 +25,8 @@ def register(sub: Any) -> None:
                      help="replace an existing --out folder even if it is not a previous run")
     run.add_argument("--gif", action="store_true", help="also write an animation run.gif")
     run.add_argument("--sil", action="append", default=[], metavar="NODE",
-                     help="run NODE (e.g. TPSC) as AVR firmware in simavr (software in the loop; `make firmware` first)")
+                     help="run NODE (e.g. TPSC; repeatable or a comma list: USRC,TPSC,IRRC,ISC,TSC,LSC,PSC) as AVR "
+                          "firmware in simavr (software in the loop; `make firmware` first)")
     run.add_argument("--console", metavar="LINE",
                      help="a VT100 terminal on the UIC/RCP's RS-232 line (seed 4.1): pty (prints the device to open "
                           "with screen/picocom), stdio (this terminal) or serial:DEVICE (pyserial); paces the run")
@@ -137,17 +138,23 @@ def cmd_run(args: argparse.Namespace) -> int:
 
     _check_file(args.scenario)
     replace_nodes = None
+    sil_made: list[Any] = []
+    sil_errors: tuple[type[Exception], ...] = ()
     if args.sil:
-        from firmware.sil_bridge import check_sil_nodes, sil_factory
+        from firmware.sil_bridge import SilError, check_sil_nodes, sil_factory, sil_names
 
-        check_sil_nodes(runner.load_spec_once(), args.sil)
-        replace_nodes = {name: sil_factory() for name in args.sil}
+        sil_errors = (SilError,)
+        names = sil_names(args.sil)
+        check_sil_nodes(runner.load_spec_once(), names)
+        replace_nodes = {name: sil_factory(made=sil_made) for name in names}
     if args.out is not None:
         runner.check_target(args.out, args.force)     # refuse before a long run, and again when writing
     console = _open_console(args.console) if args.console else None
     try:
         outcome = runner.run(args.scenario, args.seed, gif=args.gif, replace_nodes=replace_nodes,
                              console=console, pace=args.pace)
+    except sil_errors as exc:
+        raise UserError(f"--sil: the firmware run failed: {exc}") from None   # e.g. the AVR crashed in simavr
     finally:
         if console is not None:
             console.close()             # restores a raw terminal before anything is printed
@@ -159,6 +166,11 @@ def cmd_run(args: argparse.Namespace) -> int:
     print(f"output {out}")
     for name, ok, detail in outcome.expectations:
         print(f"  {'PASS' if ok else 'FAIL'} {name}: {detail}")
+    if sil_made:
+        from firmware.sil_bridge import ram_lines, ram_use
+
+        print("RAM high-water of the SIL nodes in simavr (bytes):")
+        print("\n".join(ram_lines(ram_use([n for n in sil_made if n.host.proc.poll() is None]))))
     if outcome.failed:
         sys.stderr.write(f"{outcome.scenario.path}: expectation failed: {', '.join(n for n, _, _ in outcome.failed)}\n")
         return 1

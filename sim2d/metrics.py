@@ -1,6 +1,7 @@
 """Metrics of a finished run and the scenario's expectations checked against them."""
 from __future__ import annotations
 
+import hashlib
 import math
 from bisect import bisect_left
 from typing import TYPE_CHECKING, Any, Sequence
@@ -8,12 +9,12 @@ from typing import TYPE_CHECKING, Any, Sequence
 from sim2d.gait_metrics import motion_schema
 from sim2d.nav_metrics import nav_schema
 
-from tracecheck.trace import COLUMNS, parse_lines
+from tracecheck.trace import COLUMNS, parse_lines, trace_lines
 from tracecheck.validate import validate
 
 if TYPE_CHECKING:
     from sim2d.robot import Robot
-    from sim2d.sim import Simulation
+    from sim2d.sim import Simulation, TraceEntry
 
 
 def reactions(stimuli: list[tuple[float, str]], moves: list[tuple[float, int]],
@@ -104,7 +105,8 @@ def _leaves(*names: str) -> dict[str, Any]:
     return _obj({n: _VALUE for n in names})
 
 
-_VALUE: dict[str, Any] = {"type": ["number", "string", "boolean", "null", "array"]}   # a leaf metric
+_VALUE: dict[str, Any] = {"type": ["number", "boolean", "null", "array"]}   # a leaf metric (text ones say so)
+_TEXT: dict[str, Any] = {"type": ["string", "null"]}
 _FREE: dict[str, Any] = {"type": "object"}      # a node's own debug-port figures (debug_metrics()): any keys
 
 
@@ -117,14 +119,15 @@ def metrics_schema(spec: Any, measured: Sequence[str] = ()) -> dict[str, Any]:
     bus = _leaves("load", "frames", "bytes", "collisions", "lost", "corrupted", "delayed")
     layer = _leaves("buses", "frames", "lost", "corrupted", "load_mean", "load_max")
     return _obj({
-        **{k: _VALUE for k in ("scenario", "seed", "duration_s", "distance_walked_m", "displacement_m", "final_pose",
+        "scenario": _TEXT, "trace_hash": _TEXT,
+        **{k: _VALUE for k in ("seed", "duration_s", "distance_walked_m", "displacement_m", "final_pose",
                                "collisions", "min_clearance_m", "blocked_leg_events", "pit_events", "fell",
                                "tilt_events", "max_tilt_deg", "reach_time_s", "entered_forbidden_s", "moves",
-                               "reaction_latencies_s", "max_reaction_s", "frames", "frame_loss", "frames_corrupted",
-                               "trace_hash")},
+                               "reaction_latencies_s", "max_reaction_s", "frames", "frame_loss", "frames_corrupted")},
         "battery": _leaves("v_min", "v_mean", "v_final", "emf_final_v", "i_mean_a", "i_max_a", "charge_used_ah",
                            "psc_mean_v", "psc_mean_min_v", "psc_level_min_v", "psc_alarms", "battery_low"),
-        "post": _leaves("verdict", "missing", "reasons", "time_s"),
+        "post": _obj({"verdict": {"enum": [*spec.post.verdicts, None]}, "missing": _VALUE, "reasons": _VALUE,
+                      "time_s": _VALUE}),
         "buses": _obj({name: bus for name in spec.buses}),
         "bus_layers": _obj({str(level): layer for level in sorted({b.level for b in spec.buses.values()})}),
         "notes": {"type": "object", "additionalProperties": _leaves("count", "first_s", "last_s", "walked_after_m")},
@@ -146,6 +149,12 @@ def metrics_schema(spec: Any, measured: Sequence[str] = ()) -> dict[str, Any]:
 
 def metric_path_problem(schema: dict[str, Any], path: str) -> str | None:
     """Why `path` ('notes.escape.count') can never name a metric of `schema`, or None when it can."""
+    found = metric_node(schema, path)
+    return found if isinstance(found, str) else None
+
+
+def metric_node(schema: dict[str, Any], path: str) -> dict[str, Any] | str | None:
+    """The schema of the metric at `path`, None below a node's own figures (any shape), or why there is none."""
     node = schema
     done: list[str] = []
     for part in path.split("."):
@@ -161,14 +170,24 @@ def metric_path_problem(schema: dict[str, Any], path: str) -> str | None:
             return f"{where} has no {part!r} (one of {known})"
         node = nxt
         done.append(part)
-    return None
+    return node
+
+
+def trace_hash(frames: list[TraceEntry], poses: list[tuple[float, float, float, float]]) -> str:
+    """SHA-256 over every frame (times, bus, sender, bytes sent and heard, flags) and the pose log."""
+    h = hashlib.sha256()
+    for f in frames:
+        h.update(f"{f.start:.9f} {f.end:.9f} {f.bus} {f.sender} {f.sent.hex()} "
+                 f"{f.heard.hex() if f.heard is not None else '-'} {','.join(f.flags)}\n".encode())
+    for t, x, y, th in poses:
+        h.update(f"{t:.3f} {x:.9f} {y:.9f} {th:.9f}\n".encode())
+    return h.hexdigest()
 
 
 def build_metrics(sim: "Simulation") -> dict[str, Any]:
     from sim2d.level0_io import rcp_metrics, sound_metrics
     from sim2d.nav_metrics import nav_metrics
     from sim2d.gait_metrics import motion_metrics
-    from sim2d.sim import trace_hash
     dur = sim.scenario.duration
     buses = {}
     for name, b in sim.buses.items():
@@ -232,7 +251,6 @@ def build_metrics(sim: "Simulation") -> dict[str, Any]:
 
 def protocol_metrics(sim: "Simulation") -> dict[str, Any]:
     """The run's bus trace held to the verified protocol (tracecheck): violations (0 expected), waits, K."""
-    from sim2d.sim import trace_lines
     lines = ["\t".join(COLUMNS)] + trace_lines(sim.frames, sim.notes)
     trace = parse_lines(lines, f"{sim.scenario.name}/trace.tsv", set(sim.spec.buses))
     return validate(trace, sim.spec, dict(sim.scenario.arbitration)).metrics()

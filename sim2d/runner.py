@@ -19,8 +19,8 @@ from arachnae.errors import UserError
 from sim2d.level0_io import WallClock, attach_console
 from sim2d.metrics import check_expectations
 from sim2d.scenario import Scenario, load_scenario
-from sim2d.sim import Result, Simulation, capture_frames, trace_lines
-from tracecheck.trace import COLUMNS
+from sim2d.sim import Result, Simulation, capture_frames
+from tracecheck.trace import COLUMNS, trace_lines
 
 GIF_FRAME_S = 0.5
 RUN_MARKER = ".arachnae-run"        # in every run folder: {"scenario", "name", "seed"} as JSON
@@ -41,7 +41,7 @@ class Outcome:
 
 
 def load_spec_once() -> Any:
-    from codegen.model import load_spec
+    from codegen.load import load_spec
     return load_spec()
 
 
@@ -58,6 +58,17 @@ def run(path: str, seed: int | None = None, spec: Any = None, gif: bool = False,
         attach_console(sim, console if console is not None else WallClock(), 1.0 if pace is None else pace)
     result = sim.run()
     return Outcome(sc, result, check_expectations(sc, result.metrics), bytes(sim.rcp.screen), spec)
+
+
+def run_sil(path: str, sil: tuple[str, ...], seed: int | None = None, spec: Any = None,
+            made: list[Any] | None = None) -> Outcome:
+    """`run` with the nodes in `sil` (names or comma lists) run as AVR firmware in simavr, as `arachnae sim run
+    --sil` does; the SilNodes made are appended to `made` (their RAM use can be read until they are closed)."""
+    from firmware.sil_bridge import check_sil_nodes, sil_factory, sil_names
+    spec = spec or load_spec_once()
+    names = sil_names(list(sil))
+    check_sil_nodes(spec, names)
+    return run(path, seed, spec=spec, replace_nodes={name: sil_factory(made=made) for name in names})
 
 
 def _protected(target: Path) -> str | None:

@@ -23,12 +23,12 @@ from typing import Any
 import yaml
 
 from arachnae.errors import UserError, located
-from arachnae.validation import check_schema, field_name, fill_defaults
+from arachnae.validation import Validator, check_schema, field_name, fill_defaults
 from arachnae.yamlio import LDict, LList, load_yaml, locate, new_dict, new_list
-from console.keymap import KEYMAP
+from behaviours.rcp_keys import KEYMAP
 from sim2d.geometry import (WALL_RADIUS, on_one_line, point_in_polygon, polygons_overlap, seg_seg_distance,
                             self_crossing, signed_area, to_world)
-from sim2d.metrics import metric_path_problem, metrics_schema
+from sim2d.metrics import metric_node, metrics_schema
 from sim2d.robot_params import DEFAULT as DEFAULT_PARAMS
 
 LIST_KEYS = ("walls", "obstacles", "pits", "slopes", "lights", "heat", "sounds", "faults", "operator")
@@ -406,15 +406,28 @@ def _check_metric_paths(doc: LDict, spec: Any) -> None:
         if not all(parts):
             raise locate(doc, where_, f"expect.metrics: {path!r} is not a dotted metric path")
         if schema is not None:
-            problem = metric_path_problem(schema, path)
-            if problem:
-                raise locate(doc, where_, f"expect.metrics: {path!r} names no metric: {problem}")
+            node = metric_node(schema, path)
+            if isinstance(node, str):
+                raise locate(doc, where_, f"expect.metrics: {path!r} names no metric: {node}")
+            if node is not None:
+                _check_operands(doc, where_, path, b, node)
         if parts[0] == "nodes" and len(parts) > 1 and parts[1] in absent:
             raise locate(doc, where_, f"expect.metrics: {path!r}: node {parts[1]} is absent in this scenario")
         if "min" in b and "max" in b and b["min"] > b["max"]:
             raise locate(doc, where_, f"expect.metrics.{path}: min {b['min']} is above max {b['max']}")
         if "eq" in b and len(b) > 1:
             raise locate(doc, where_, f"expect.metrics.{path}: eq with min or max; give one or the other")
+
+
+def _check_operands(doc: LDict, where_: list[Any], path: str, bounds: Any, metric: dict[str, Any]) -> None:
+    """An `eq` the metric can never equal (text for a number, a verdict the spec lacks) or a min/max on a
+    metric that is not a number is a mistake found now, not a run that fails at its end."""
+    valid = Validator(metric).is_valid
+    if "eq" in bounds and not valid(bounds["eq"]):
+        raise locate(doc, where_ + ["eq"], f"expect.metrics.{path}: eq {bounds['eq']!r} is not a value this metric takes")
+    for key in ("min", "max"):
+        if key in bounds and not valid(bounds[key]):
+            raise locate(doc, where_ + [key], f"expect.metrics.{path}: {key} {bounds[key]!r}: this metric is not a number")
 
 
 def _pt(p: Any) -> tuple[float, float]:

@@ -11,7 +11,6 @@ is stepped per bit or per byte.
 """
 from __future__ import annotations
 
-import hashlib
 import math
 from dataclasses import dataclass, field, replace
 from typing import Any, Callable
@@ -22,7 +21,6 @@ from arachnae_proto.messages import BY_NAME as MESSAGES
 from arachnae_proto.network import BROADCAST
 
 from behaviours import behaviour_class
-from captures.decode import decode
 from captures.pcapng import CapturedFrame
 from behaviours.netconfig import Config, NetConfig
 from behaviours.post import Verdict
@@ -38,7 +36,6 @@ from sim2d.robot_params import DEFAULT, RobotParams
 from sim2d.scenario import Scenario
 from sim2d.sensors import Sensors
 from sim2d.world import World
-from tracecheck.trace import frame_row, note_row
 
 POSE_SAMPLE_S = 0.1       # pose log resolution (trace hash, plot)
 CLEARANCE_SAMPLE_S = 0.05
@@ -333,22 +330,6 @@ class Simulation:
                       self.sensors, self.world, self.robot, self.snapshots, self.nodes, self.notes)
 
 
-def trace_lines(frames: list[TraceEntry], notes: list[tuple[float, str, str, dict[str, Any]]] = ()) -> list[str]:
-    """One tab-separated line per frame (tracecheck.trace.COLUMNS: start, end, bus, sender, src, dst,
-    message, bytes heard, flags, bytes sent), in the order the frames ended, with the debug-port notes the
-    protocol validator needs (the POST verdict) as `debug` rows at their time.
-
-    The message column is what the generated codec parses from the bytes heard
-    (arachnae_proto.frame.parse, Message.describe()); a frame it rejects shows
-    the codec's reason.
-    """
-    rows = [(f.end, 1, frame_row(f.start, f.end, f.bus, f.sender, f.sent, f.heard, f.flags)) for f in frames]
-    rows += [(t, 0, row) for t, node, event, data in notes
-             if (row := note_row(t, node, event, data)) is not None]
-    rows.sort(key=lambda r: (r[0], r[1]))
-    return [row for _t, _k, row in rows]
-
-
 def capture_frames(frames: list[TraceEntry]) -> list[CapturedFrame]:
     """The frames as a tap on each bus saw them (bus.pcapng), in order of their start.
 
@@ -359,14 +340,3 @@ def capture_frames(frames: list[TraceEntry]) -> list[CapturedFrame]:
            for f in frames]
     out.sort(key=lambda c: c.time_ns)
     return out
-
-
-def trace_hash(frames: list[TraceEntry], poses: list[tuple[float, float, float, float]]) -> str:
-    """SHA-256 over every frame (times, bus, sender, bytes sent and heard, flags) and the pose log."""
-    h = hashlib.sha256()
-    for f in frames:
-        h.update(f"{f.start:.9f} {f.end:.9f} {f.bus} {f.sender} {f.sent.hex()} "
-                 f"{f.heard.hex() if f.heard is not None else '-'} {','.join(f.flags)}\n".encode())
-    for t, x, y, th in poses:
-        h.update(f"{t:.3f} {x:.9f} {y:.9f} {th:.9f}\n".encode())
-    return h.hexdigest()

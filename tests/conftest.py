@@ -15,7 +15,7 @@ def repo() -> Path:
 
 @pytest.fixture(scope="session")
 def spec():
-    from codegen.model import load_spec
+    from codegen.load import load_spec
 
     return load_spec()
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterable
 
 from arachnae.errors import UserError, located
 from arachnae_proto import CodecError
@@ -89,6 +89,18 @@ def frame_row(start: float, end: float, bus: str, sender: str, sent: bytes, hear
     d = decode(data)
     return (f"{start:.6f}\t{end:.6f}\t{bus}\t{sender}\t{d.src}\t{d.dst}\t{d.text}\t{data.hex()}\t{','.join(flags)}"
             f"\t{sent.hex()}")
+
+
+def trace_lines(frames: Iterable[Any], notes: Iterable[tuple[float, str, str, dict[str, Any]]] = ()) -> list[str]:
+    """trace.tsv's rows for a run's frames (sim2d.bus.TraceEntry: start, end, bus, sender, sent, heard, flags)
+    in the order they ended, with the debug-port notes the protocol rules need (the POST verdict) as `debug`
+    rows at their time. The message column is the generated codec's reading of the bytes heard
+    (captures.decode); a frame it rejects shows the codec's reason."""
+    rows = [(f.end, 1, frame_row(f.start, f.end, f.bus, f.sender, f.sent, f.heard, f.flags)) for f in frames]
+    rows += [(t, 0, row) for t, node, event, data in notes
+             if (row := note_row(t, node, event, data)) is not None]
+    rows.sort(key=lambda r: (r[0], r[1]))
+    return [row for _t, _k, row in rows]
 
 
 def _parse_or_none(data: bytes) -> Parsed | None:

@@ -131,6 +131,37 @@ uint8_t hal_echo_status(void)
     return (PINC & _BV(PC2)) ? HAL_ECHO_CORRUPT : HAL_ECHO_OK;
 }
 
+uint16_t hal_line_quiet_ms(void)
+{
+    uint16_t now = hal_ms(), rx;
+    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) { rx = last_rx_ms; }
+    if (TCCR1B != 0u)                           /* a frame is coming in */
+        return 0;
+    rx = (uint16_t)(now - rx);
+    return sent && (uint16_t)(now - tx_end_ms) < rx ? (uint16_t)(now - tx_end_ms) : rx;
+}
+
+/* Sensor front end on GPIOR0..2 (firmware/sil/sil_host.c answers in the SIL): argument in
+   GPIOR1/GPIOR2, the request code in GPIOR0, then the reply bytes read from GPIOR0. */
+static void port_request(uint8_t code, uint16_t arg)
+{
+    GPIOR1 = (uint8_t)arg;
+    GPIOR2 = (uint8_t)(arg >> 8);
+    GPIOR0 = code;
+}
+
+void hal_sample(uint8_t kind, uint16_t arg, int16_t *out, uint8_t n)
+{
+    uint8_t i;
+    port_request(kind, arg);
+    for (i = 0; i < n; i++) {
+        uint8_t lo = GPIOR0;
+        out[i] = (int16_t)((uint16_t)lo | (uint16_t)((uint16_t)GPIOR0 << 8));
+    }
+}
+
+void hal_note(uint8_t kind, uint16_t arg) { port_request(kind, arg); }
+
 uint8_t hal_inputs(void) { return (uint8_t)((uint8_t)~PINC & 0x03u); }
 
 void hal_test_point(uint8_t on)

@@ -104,6 +104,46 @@ uint8_t hal_echo_status(void)
 
 uint8_t hal_inputs(void) { return (uint8_t)(~GPIO_IN & 0x03u); }
 
+uint16_t hal_line_quiet_ms(void)
+{
+    uint16_t rx = (uint16_t)(ms - last_rx_ms), tx = (uint16_t)(ms - tx_end_ms);
+    if (gap_armed)
+        return 0;
+    return sent && tx < rx ? tx : rx;
+}
+
+/* Sensor front end on SPI0 (nRF51 registers): request code and argument out, reply in. */
+#define SPI_READY REG(0x40003108UL)
+#define SPI_RXD REG(0x40003518UL)
+#define SPI_TXD REG(0x4000351CUL)
+static uint8_t spi_xfer(uint8_t out)
+{
+    SPI_READY = 0;
+    SPI_TXD = out;
+    while (SPI_READY == 0u)
+        ;
+    return (uint8_t)SPI_RXD;
+}
+
+static void port_request(uint8_t code, uint16_t arg)
+{
+    (void)spi_xfer(code);
+    (void)spi_xfer((uint8_t)arg);
+    (void)spi_xfer((uint8_t)(arg >> 8));
+}
+
+void hal_sample(uint8_t kind, uint16_t arg, int16_t *out, uint8_t n)
+{
+    uint8_t i;
+    port_request(kind, arg);
+    for (i = 0; i < n; i++) {
+        uint8_t lo = spi_xfer(0);
+        out[i] = (int16_t)((uint16_t)lo | (uint16_t)((uint16_t)spi_xfer(0) << 8));
+    }
+}
+
+void hal_note(uint8_t kind, uint16_t arg) { port_request(kind, arg); }
+
 void hal_test_point(uint8_t on)
 {
     if (on)

@@ -1,24 +1,22 @@
 /*
  * TPSC behaviour (seed 3.2.12): two whisker switches; the TPSC always initiates.
- * On a new contact it sends DATA_RDY to the SPU and answers the SPU's XMIT_DATA
- * with XMIT_DATA_TPSC (OBJ_LEFT 0x10, OBJ_RIGHT 0x20, OBJ_BOTH 0x40).
- * Same behaviour as sim2d/behaviours/sensor_nodes.py TPSC, for the SIL run.
+ * On a new contact it sends DATA_RDY to the SPU (at most once per the reflex's
+ * min_interval, spec reflexes / seed 5.2; a contact sooner than that goes with the
+ * next request) and answers the SPU's XMIT_DATA with XMIT_DATA_TPSC (OBJ_LEFT 0x10,
+ * OBJ_RIGHT 0x20, OBJ_BOTH 0x40). Same behaviour as behaviours/sensors.py TPSC.
  */
 #include "role_config.h"
 #include "hal.h"
+#include "lib/sensor.h"
 
-#define SCAN_MS 20u        /* switch scan / debounce period (sim2d: tick_period 0.02) */
 #define STIMULUS_MS 2u     /* width of the test-point pulse marking a detected contact */
 
-enum { TX_IDLE, TX_WAIT_ECHO, TX_BACKOFF };
-
 typedef struct {
+    fw_slave slave;
     uint8_t contact;       /* contact code of the last scan */
     uint8_t latched;       /* contact that caused the pending DATA_RDY, until fetched */
-    uint8_t data_rdy;      /* 1 while a DATA_RDY waits to get through */
-    uint8_t tx;
-    uint16_t last_scan, backoff_until, pulse_until;
-    uint8_t pulse;
+    uint8_t requested, held, pulse;
+    uint16_t last_scan, requested_at, pulse_until;
 } tpsc_state;
 
 static tpsc_state st;
@@ -35,6 +33,19 @@ static uint8_t contact_code(uint8_t inputs)
     return 0;
 }
 
+/* DATA_RDY, at most once per the reflex's min_interval (spec reflexes): a contact sooner than that
+   is latched and goes with the next request; the STOP of the last one is already on its way (5.2) */
+static void request(uint16_t now)
+{
+    if (st.requested && (uint16_t)(now - st.requested_at) < FW_REFLEX_MIN_INTERVAL_MS) {
+        st.held = 1;
+        return;
+    }
+    st.requested = 1;
+    st.requested_at = now;
+    fw_announce(&st.slave, now, 1);
+}
+
 void tpsc_send(tpsc_node *node, const uint8_t *frame, uint16_t len)
 {
     (void)node;
@@ -45,9 +56,6 @@ void tpsc_on_init(tpsc_node *node, const arachnae_header *h)
 {
     (void)node;
     (void)h;
-    st.latched = 0;
-    st.data_rdy = 0;
-    st.tx = TX_IDLE;
 }
 
 void tpsc_on_status_req(tpsc_node *node, const arachnae_header *h, arachnae_status_ack_order_t *reply)
@@ -68,71 +76,37 @@ void tpsc_on_xmit_data(tpsc_node *node, const arachnae_header *h)
     if (arachnae_xmit_data_tpsc_build(&m, h->src, node->address, out, sizeof out, &n) == ARACHNAE_OK)
         tpsc_send(node, out, n);
     st.latched = 0;
-    /* a DATA_RDY whose echo was corrupt is still resent, as in the Python node */
 }
 
-static void send_data_rdy(tpsc_node *node)
+void fw_behaviour_init(void *vnode)
 {
-    uint8_t out[ARACHNAE_DATA_RDY_FRAME_MAX];
-    uint16_t n = 0;
-    if (arachnae_data_rdy_build(FW_MASTER_ADDRESS, node->address, out, sizeof out, &n) == ARACHNAE_OK) {
-        tpsc_send(node, out, n);
-        st.tx = TX_WAIT_ECHO;
-    }
-}
-
-void fw_behaviour_init(void *node)
-{
-    (void)node;
+    fw_slave_init(&st.slave, ((tpsc_node *)vnode)->address);
     st.contact = contact_code(hal_inputs());
-    st.tx = TX_IDLE;
 }
 
 void fw_behaviour_poll(void *vnode, uint16_t now)
 {
-    tpsc_node *node = (tpsc_node *)vnode;
+    (void)vnode;
     if (st.pulse && (int16_t)(now - st.pulse_until) >= 0) {
         st.pulse = 0;
         hal_test_point(0);
     }
-    if ((uint16_t)(now - st.last_scan) >= SCAN_MS) {
+    if ((uint16_t)(now - st.last_scan) >= TUNING_TPSC_SCAN_MS) {
         uint8_t c = contact_code(hal_inputs());
         st.last_scan = now;
         if (c != 0u && c != st.contact) {
             st.latched = c;
-            st.data_rdy = 1;               /* seed 3.2.12: the TPSC always initiates */
-            st.pulse = 1;
+            st.pulse = 1;                  /* the stimulus, on the test point */
             st.pulse_until = (uint16_t)(now + STIMULUS_MS);
             hal_test_point(1);
+            request(now);                  /* seed 3.2.12: the TPSC always initiates */
         }
         st.contact = c;
     }
-    switch (st.tx) {
-    case TX_IDLE:
-        if (st.data_rdy && hal_line_idle())
-            send_data_rdy(node);
-        break;
-    case TX_WAIT_ECHO:
-        switch (hal_echo_status()) {
-        case HAL_ECHO_OK:
-            st.data_rdy = 0;
-            st.tx = TX_IDLE;
-            break;
-        case HAL_ECHO_CORRUPT:
-            /* seed 3.2.2 + spec arbitration address_backoff: wait (rank + 1) slots, then resend */
-            st.backoff_until = (uint16_t)(now + (FW_BACKOFF_RANK + 1u) * FW_BACKOFF_SLOT_US / 1000u);
-            st.tx = TX_BACKOFF;
-            break;
-        default:
-            break;
-        }
-        break;
-    default:
-        if ((int16_t)(now - st.backoff_until) >= 0) {
-            st.tx = TX_IDLE;
-            if (st.data_rdy && hal_line_idle())
-                send_data_rdy(node);
-        }
-        break;
+    if (st.held && (uint16_t)(now - st.requested_at) >= FW_REFLEX_MIN_INTERVAL_MS) {
+        st.held = 0;
+        if (st.latched)
+            request(now);
     }
+    fw_slave_poll(&st.slave, now);
 }

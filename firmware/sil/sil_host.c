@@ -13,7 +13,14 @@
  *               simavr raises RXC one character time after that (its own baud timing)
  *   s PIN V     drive input pin PIN to V (0 or 1)
  *   m           m MIN_SP RAMEND: lowest stack pointer seen so far
+ *   v HH...     bytes the firmware reads next from its sensor port (GPIOR0), in order
+ *   d ADDR N    d HH...      N bytes of data memory from ADDR (the firmware's debug record)
  *   q           quit
+ * Sensor port (avr/hal_avr.c): the firmware writes an argument to GPIOR1 (low) and
+ * GPIOR2 (high), then a request code to GPIOR0; the host answers
+ *   a CYCLE CODE ARG   and stops right after that write, so the caller can load the
+ * reply with `v` before the firmware reads it from GPIOR0 (a sensor front end that
+ * converts at once; an empty port reads 0).
  * If the AVR crashes or stops: "x CYCLE STATE", exit status 1. Everything simavr
  * itself prints goes to stderr, so stdout carries only the protocol.
  */
@@ -24,6 +31,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "avr_extint.h"
 #include "avr_ioport.h"
 #include "avr_uart.h"
 #include "sim_avr.h"
@@ -42,6 +50,32 @@ static struct { avr_cycle_count_t at; uint8_t byte; } inq[MAX_INPUT];
 static unsigned in_head, in_tail;
 
 static struct { char port; int bit; } watch[MAX_WATCH];
+
+/* data-space addresses of GPIOR0..2 on the ATmega328P: the SIL sensor port */
+#define PORT_CODE 0x3E
+#define PORT_ARG_LO 0x4A
+#define PORT_ARG_HI 0x4B
+#define MAX_REPLY 64
+static uint8_t reply[MAX_REPLY];
+static unsigned reply_head, reply_len;
+
+static void on_port_write(avr_t *a, avr_io_addr_t addr, uint8_t v, void *param)
+{
+    (void)param;
+    a->data[addr] = v;
+    reply_head = reply_len = 0;
+    fprintf(proto, "a %llu %u %u\n", (unsigned long long)a->cycle, v,
+            (unsigned)(a->data[PORT_ARG_LO] | (a->data[PORT_ARG_HI] << 8)));
+    stop_now = 1;
+}
+
+static uint8_t on_port_read(avr_t *a, avr_io_addr_t addr, void *param)
+{
+    (void)a;
+    (void)addr;
+    (void)param;
+    return reply_head < reply_len ? reply[reply_head++] : 0u;
+}
 static int nwatch;
 
 static void no_sleep(avr_t *a, avr_cycle_count_t how_long)
@@ -153,6 +187,12 @@ int main(int argc, char **argv)
     avr_init(avr);
     avr_load_firmware(avr, &fw);
     avr->sleep = no_sleep;
+    /* INT0/INT1 are off, but simavr polls a low level on their pins (PD2 is DE, low
+       while listening) every cycle; that would make each sleeping cycle a step */
+    avr_extint_set_strict_lvl_trig(avr, 0, 0);
+    avr_extint_set_strict_lvl_trig(avr, 1, 0);
+    avr_register_io_write(avr, PORT_CODE, on_port_write, NULL);
+    avr_register_io_read(avr, PORT_CODE, on_port_read, NULL);
     avr_ioctl(avr, AVR_IOCTL_UART_SET_FLAGS('0'), &flags);   /* no console echo, no polling usleep */
     avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUTPUT), on_uart_out, NULL);
     for (opt = 0; opt < nwatch; opt++)
@@ -193,6 +233,30 @@ int main(int argc, char **argv)
                 return 1;
             }
             avr_raise_irq(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(port), bit), v ? 1u : 0u);
+        } else if (line[0] == 'v') {
+            char *p = line + 1, *end;
+            reply_head = reply_len = 0;
+            for (;;) {
+                unsigned long b = strtoul(p, &end, 16);
+                if (end == p)
+                    break;
+                if (reply_len >= MAX_REPLY || b > 0xFFu) {
+                    fprintf(stderr, "sil_host: bad sensor reply: %s", line);
+                    return 1;
+                }
+                reply[reply_len++] = (uint8_t)b;
+                p = end;
+            }
+        } else if (sscanf(line, "d %llu %u", &c, &v) == 2) {
+            unsigned k;
+            if (c + v > (unsigned long long)avr->ramend + 1u) {
+                fprintf(stderr, "sil_host: bad memory range: %s", line);
+                return 1;
+            }
+            fputc('d', proto);
+            for (k = 0; k < v; k++)
+                fprintf(proto, " %02x", avr->data[c + k]);
+            fputc('\n', proto);
         } else if (line[0] == 'm') {
             fprintf(proto, "m %u %u\n", min_sp, avr->ramend);
         } else {

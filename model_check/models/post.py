@@ -2,7 +2,7 @@
 
 The MCP tests itself, then identifies its slaves in address order; a sub-master
 that answers identifies its own slaves the same way and reports upward with
-POST_REPORT (SPEC-NOTES decision 2). Each identification is one step with the
+POST_REPORT (docs/decisions.md D2). Each identification is one step with the
 outcomes the id_retry model proves the ID_REQ/timeout/retry exchange can end
 in: present (ID_ACK), absent or mute (no ID_ACK after the retry) and
 out-of-order (ID_ACK but a status in post.inactive_statuses). A mute or

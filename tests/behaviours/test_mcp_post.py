@@ -1,4 +1,4 @@
-"""MCP POST (seed 6.3, 3.2.2; SPEC-NOTES decisions 2 and 3): ID_REQ with one retry, sub-master reports, the verdict."""
+"""MCP POST (seed 6.3, 3.2.2; docs/decisions.md D2, D3): ID_REQ with one retry, sub-master reports, the verdict."""
 from __future__ import annotations
 
 import pytest

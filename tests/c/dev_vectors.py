@@ -17,7 +17,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO))
 
-from codegen.model import load_spec  # noqa: E402
+from codegen.load import load_spec  # noqa: E402
 
 SPEC = load_spec()
 

@@ -17,7 +17,7 @@ import pytest
 
 from codegen.encoding import MILLI, Linear
 from codegen.generate import REPO, render, stale
-from codegen.model import load_spec
+from codegen.load import load_spec
 
 HERE = Path(__file__).resolve().parent
 GEN = REPO / "generated" / "c"

@@ -78,7 +78,7 @@ def hostile_spec(tmp_path, repo):
     import json
     import shutil
 
-    from codegen.model import load_spec
+    from codegen.load import load_spec
 
     spec_dir = tmp_path / "spec"
     shutil.copytree(repo / "spec", spec_dir)

@@ -85,7 +85,7 @@ def test_random_payloads_only_raise_codec_errors(spec) -> None:
 @settings(max_examples=500, deadline=None)
 @given(data=st.binary(min_size=6, max_size=40), flip=st.integers(0, 39), bit=st.integers(0, 7))
 def test_every_single_bit_error_is_detected(data: bytes, flip: int, bit: int) -> None:
-    # SPEC-NOTES decision 1: the checksum detects every single-byte error
+    # docs/decisions.md D1: the checksum detects every single-byte error
     good = data[:-2] + frame.crc(data[:-2]).to_bytes(2, "big")
     bad = bytearray(good)
     bad[flip % len(bad)] ^= 1 << bit

@@ -37,7 +37,7 @@ def test_crc_lines(vectors):
 
 
 def test_checksum_catalogue_check_value(spec):
-    # SPEC-NOTES decision 1: the named polynomial's catalogue check value over "123456789"
+    # docs/decisions.md D1: the named polynomial's catalogue check value over "123456789"
     assert frame.crc(b"123456789") == spec.frame.checksum.check == 0x29B1
 
 

@@ -13,7 +13,8 @@ from pathlib import Path
 import pytest
 
 from arachnae.errors import UserError
-from codegen.model import SPEC_DIR, load_spec
+from codegen.model import SPEC_DIR
+from codegen.load import load_spec
 
 N, M = "nodes.yaml", "messages.yaml"
 

@@ -11,7 +11,7 @@ import pytest
 from arachnae_proto import messages as M
 from arachnae_proto.enums import Alert, MovCmd
 from console import KEYMAP, Screen, message_for_key
-from console.screen import CLEAR_LINE, LCD_COL, LCD_TOP_ROW, goto
+from behaviours.rcp_screen import CLEAR_LINE, LCD_COL, LCD_TOP_ROW, goto
 from console.terminal import attach, open_pty
 
 

@@ -22,7 +22,7 @@ from arachnae_proto.enums import MovCmd
 from arachnae_proto.frame import parse
 from arachnae_proto.messages import LcdText, Move, PostReq
 from arachnae_proto.network import ADDRESS_OF
-from console.screen import LCD_COL, LCD_TOP_ROW, fit_lcd, goto
+from behaviours.rcp_screen import LCD_COL, LCD_TOP_ROW, fit_lcd, goto
 from console.terminal import attach
 
 REPO = Path(__file__).resolve().parents[2]

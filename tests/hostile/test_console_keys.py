@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import pytest
 
-from console.keymap import KeyDecoder, message_for_key
-from console.screen import Screen
+from behaviours.rcp_keys import KeyDecoder, message_for_key
+from behaviours.rcp_screen import Screen
 
 # (name, bytes typed (one read per item), the keys that come out)
 CASES = [

@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 
 from arachnae.errors import UserError
 from codegen.generate import render, write
-from codegen.model import load_spec
+from codegen.load import load_spec
 from tests.hostile.spec_harness import SPEC, M, N, compile_c, import_python
 
 HOSTILE_TEXT = ["*/ #error injected /*", '"""', "ends in a backslash \\", "*??/", "one\n#define X\n", "\r\x00\x1b[2J",

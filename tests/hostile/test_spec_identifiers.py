@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from codegen.generate import render
-from codegen.model import load_spec
+from codegen.load import load_spec
 from codegen.templates.c import names as c_names
 from codegen.templates.c import view as c_view
 from codegen.templates.python import names as py_names

@@ -52,7 +52,7 @@ def test_reference_in_chromium(browser, reference, spec, tmp_path):
 
 
 def test_spec_strings_are_escaped(browser, repo, tmp_path):
-    from codegen.model import load_spec
+    from codegen.load import load_spec
 
     spec_dir = tmp_path / "spec"
     shutil.copytree(repo / "spec", spec_dir)

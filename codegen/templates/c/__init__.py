@@ -285,6 +285,13 @@ class MessageView:
     def array_wire(self) -> str:
         return " && ".join(self.array.wire_conds(f"payload[{self.fixed_size}u + i]")) if self.array else ""
 
+    @property
+    def size_expr(self) -> str:
+        """C expression: payload bytes of the checked struct `m` (fixed part plus the array's count)."""
+        if self.array is None:
+            return f"{self.fixed_size}u"
+        return f"(uint16_t)({self.fixed_size}u + m->{self.count_field.name})"
+
     def pack_bytes(self, m: str = "m") -> list[tuple[int, str]]:
         """(payload byte index, C expression) for every byte of the fixed part."""
         out = []
@@ -319,6 +326,20 @@ class RoleView:
         return f"ARACHNAE_NODE_{self.role.upper()}_H"
 
     @property
+    def empty_receives(self) -> list[MessageView]:
+        """Received messages without fields: one shared `len != 0` check in the payload check."""
+        return [m for m in self.receives if not m.has_fields]
+
+    @property
+    def field_others(self) -> list[MessageView]:
+        """Received messages with fields that reach a behaviour callback (decoded into node->msg)."""
+        return [m for m in self.others if m.has_fields]
+
+    @property
+    def field_receives(self) -> list[MessageView]:
+        return [m for m in self.receives if m.has_fields]
+
+    @property
     def reply_max(self) -> int:
         return max([m.frame_max for m in (self.id_ack, self.status_ack) if m is not None] or [0])
 
@@ -341,6 +362,12 @@ class FrameView:
     crc_reflected: bool
     crc_fast_1021: bool
     crc_check: int
+
+    @property
+    def crc_residue_zero(self) -> bool:
+        """The CRC over header, payload and the big-endian CRC itself is 0 for a good frame
+        (MSB-first CRC, no xorout), so the check needs no second read of the CRC bytes."""
+        return not self.crc_reflected and self.crc_xorout == 0
 
 
 def _frame_view(spec: Spec) -> FrameView:

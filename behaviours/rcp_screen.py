@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from arachnae_proto.enums import Alert
 
-from console.keymap import HELP
+from behaviours.rcp_keys import HELP
 
 ESC = "\x1b"
 LCD_COLS, LCD_ROWS = 16, 2
