@@ -27,8 +27,7 @@ already holds in rank order (queue_ahead of them before the carrier).
 Abstracted away, and why: node processing time (not in the spec; the
 simulator measures it); POST traffic (the bound is one of operation); a
 contact sooner than reflexes.min_interval_ms after the last reflex request
-(the TPSC latches it, and the STOP of that request is already on its way):
-tracecheck checks on every trace that the source keeps that interval.
+(the TPSC latches it, and the STOP of that request is already on its way).
 """
 from __future__ import annotations
 
