@@ -15,8 +15,6 @@ What is checked, and where each rule comes from:
   id_retries resends, then the node counts as inactive;
 - the POST verdict (seed 6.3) is the POST model's own oracle
   (`post.expected_verdict`) over the nodes that answered on the wire;
-- a reflex source raises a request at most every reflexes.min_interval_ms
-  (which the reaction model abstracts away);
 - MOVE_RELAYED resends follow protocol.move_retries; INIT is broadcast once
   after each POST that did not halt (seed 3.2.3); every record that reaches
   the MCP is relayed to its target (seed 3.2.2: every datum runs through it).
@@ -336,7 +334,6 @@ class Validator:
                 close(who, ep, end, "served")
         for who, ep in list(episodes.items()):
             close(who, ep, self.end_t, "open")
-        self.reflex_rate(r, done)
         # the master's own traffic: frames that neither request nor serve, and their gaps
         own = [f for f in frames if f.line not in service and not self.is_request(r, f)]
         own_start = [f.start for f in own]
@@ -367,22 +364,6 @@ class Validator:
                 self.report.add(ep["first"], "bound_K", f"{ep['slave']}'s request {what} after {wait:.1f} slots "
                                 f"of contention, more than K = {k} slots the checker proves for bus {r.name}")
         self.report.max_wait_slots[r.name] = max(self.report.max_wait_slots.get(r.name, 0.0), worst)
-
-    def reflex_rate(self, r: BusRules, episodes: list[dict[str, Any]]) -> None:
-        """spec reflexes min_interval_ms: a reflex source raises a request at most this often (contacts in
-        between are latched). The reaction model leaves this out (a contact that soon is stopped by the STOP
-        already on its way), so it is checked here: from one request's first frame to the next one's, less a
-        slot, since a request starts within a slot of being raised (the reaction model's align step)."""
-        for rx in self.rules.spec.reflexes:
-            if self.rules.node[rx.source].bus != r.name:
-                continue
-            firsts = sorted((ep["first"] for ep in episodes if ep["slave"] == rx.source), key=lambda f: f.start)
-            self.report.checked["reflex_rate"] += len(firsts)
-            for a, b in zip(firsts, firsts[1:]):
-                if b.start - a.start < rx.min_interval_ms / 1000 - r.slot_s - EPS:
-                    self.report.add(b, "reflex_rate", f"{rx.source} raised a request {(b.start - a.start) * 1e3:.1f} ms "
-                                    f"after its last, sooner than reflexes.{rx.name}.min_interval_ms = "
-                                    f"{rx.min_interval_ms:g} ms")
 
     # -- identification ------------------------------------------------------------------------
     def id_exchanges(self, r: BusRules, frames: list[TraceFrame]) -> None:

@@ -135,35 +135,3 @@ def test_untimed_check_still_names_a_missing_retry(saved, tmp_path):
     assert p.returncode == 1 and "id_retry" in out["by_rule"] and "bound_K" not in out["by_rule"]
     assert "no reply to ID_REQ 1 of 2 to PSC" in out["first"]
     assert "request_slot" not in out["checked"] and "one_talker" not in out["checked"]
-
-
-def test_a_reflex_request_sooner_than_min_interval_is_named(spec):
-    """spec reflexes whisker_stop.min_interval_ms (abstracted away by the reaction model, checked on traces):
-    the source's second request, raised 100 ms after its first, is named; 400 ms after it, it is not."""
-    from arachnae_proto import messages as M
-    from arachnae_proto.frame import build
-    from arachnae_proto.network import ADDRESS_OF
-    from tracecheck.trace import COLUMNS, frame_row, parse_lines
-    from tracecheck.validate import validate
-
-    rx = spec.reflexes[0]
-    bus = spec.node(rx.source).bus
-    master = spec.buses[bus].master
-    char = spec.buses[bus].char_time_us * 1e-6
-
-    def trace(second_at: float):
-        rows, t = [], 1.0
-        for at in (1.0, second_at):
-            t = at
-            for who, to, msg in ((rx.source, master, M.DataRdy()), (master, rx.source, M.XmitData())):
-                data = build(ADDRESS_OF[to], ADDRESS_OF[who], msg)
-                rows.append(frame_row(t, t + len(data) * char, bus, who, data, data, ()))
-                t += len(data) * char + 0.04
-        return parse_lines(["\t".join(COLUMNS)] + rows, "synthetic.tsv", set(spec.buses))
-
-    fast = validate(trace(1.1), spec)
-    assert [v.rule for v in fast.violations] == ["reflex_rate"], [str(v) for v in fast.violations]
-    assert fast.violations[0].t == pytest.approx(1.1) and fast.violations[0].bus == bus
-    assert f"min_interval_ms = {rx.min_interval_ms:g} ms" in fast.violations[0].text
-    slow = validate(trace(1.4), spec)
-    assert slow.violations == [] and slow.checked["reflex_rate"] == 2
