@@ -13,7 +13,7 @@ from typing import Sequence
 from arachnae.errors import UserError
 
 # Parts that contribute subcommands; a part that is not installed yet is skipped.
-PARTS = ("codegen.cli", "model_check.cli", "sim2d.cli", "captures.cli")
+PARTS = ("codegen.cli", "model_check.cli", "tracecheck.cli", "sim2d.cli", "captures.cli")
 
 
 class _Parser(argparse.ArgumentParser):

@@ -130,7 +130,9 @@ class MCP(PostMaster, Runtime, McpSkeleton):
     def _record(self, src: int, msg: M.Message) -> None:
         if isinstance(msg, M.Move):
             if not self.halted:         # seed 3.2.2: a halted robot stays stopped
-                self.relay_move(src, msg.mov_cmd, msg.param, 1 + self.net.protocol.move_retries)
+                # relayed before the next grant, like a record (the arbitration model's deliver step; at priority
+                # 0 a steady flow of the SPU's records kept an NP3 MOVE from the MMC: tracecheck's K bound)
+                self.relay_move(src, msg.mov_cmd, msg.param, 1 + self.net.protocol.move_retries, PRIORITY_RELAY)
         elif isinstance(msg, M.PostReq):
             self.on_post_req(src, msg)
         elif isinstance(msg, M.XmitRecord) and msg.target == ADDRESS_OF["NP3"]:

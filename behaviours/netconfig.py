@@ -59,6 +59,7 @@ class NetConfig:
     backoff_slots: int                     # spec arbitration.address_backoff: slots per rank step
     backoff_scope: str                     # 'all' (every slave defers after a collision) | 'colliders'
     requesters: dict[str, tuple[int, ...]]  # bus -> addresses of the slaves sending its request_message, in rank order
+    request_opcodes: dict[str, int]        # bus -> opcode of its request_message (a window slot, not a pause)
     inactive_statuses: tuple[str, ...]     # seed 6.3: a node reporting one of these counts as missing
     quorums: tuple[Quorum, ...]
     units: dict[int, dict[str, int]]       # address -> {'leg': n, 'joint': m} where the spec gives them
@@ -101,6 +102,8 @@ class NetConfig:
             reflexes=tuple(Reflex(spec.node(r.source).address, spec.node(r.actor).address, spec.node(r.to).address,
                                   r.command, r.min_interval_ms / 1000) for r in spec.reflexes),
             reflex_lead_bits=int(backoff.get("reflex_lead_bits", 0)),
+            request_opcodes={name: spec.message(b.request_message).opcode
+                             for name, b in spec.buses.items() if b.request_message},
             inactive_statuses=tuple(spec.post.inactive_statuses),
             quorums=tuple(Quorum(q.name, q.unit_key, tuple(q.unit_roles), int(q.min_complete)) for q in spec.post.quorums),
             units={n.address: {k: v for k, v in (("leg", n.leg), ("joint", n.joint)) if v is not None}

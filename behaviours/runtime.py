@@ -11,11 +11,12 @@ dispatches; this adds
     echo, and a reply not begun within the bus's response timeout is retried
     `id_retries` times (seed 3.2.2: 10 ms, one retry);
   - `slave_send(...)`: a slave-initiated frame, started only on a line idle
-    for longer than the turnaround, resent after a corrupt echo following the
+    long enough that no polled reply can be due (Runtime._slave_start), resent after a corrupt echo following the
     bus's arbitration rule (address_backoff with scope `all`: after any corrupt
     frame every slave waits for its own slot, rank x backoff_slots, of the window
-    that follows; the rule the model checker proves bounded). A request carrying
-    a reflex (spec reflexes, seed 5.2) starts at the frame gap, every other one
+    that follows, counted in idle slots, one request per slot; the rule the model
+    checker proves bounded and tracecheck holds every trace to). A request
+    carrying a reflex (spec reflexes, seed 5.2) starts first, every other one
     reflex_lead_bits later, so the reflex is on the line first.
 Bus timing comes from arachnae_proto.network.BUSES, protocol rules from the
 host-supplied NetConfig: nothing here is a number of its own.
@@ -25,9 +26,10 @@ from __future__ import annotations
 from collections import deque
 from typing import Any, Callable
 
-from arachnae_proto.frame import OVERHEAD, Frame, build
+from arachnae_proto import CodecError
+from arachnae_proto.frame import OVERHEAD, Frame, build, check
 from arachnae_proto.messages import Message
-from arachnae_proto.network import BROADCAST, BUSES, NODES
+from arachnae_proto.network import ADDRESS_OF, BROADCAST, BUSES, NODES
 
 from behaviours.hardware import Hardware
 from behaviours.netconfig import Config
@@ -42,16 +44,17 @@ PRIORITY_REFLEX = 4    # a reflex (spec reflexes, seed 5.2) before everything
 class BusTiming:
     """One bus's timing from the spec (nodes.yaml `buses`, via arachnae_proto)."""
 
-    __slots__ = ("char_s", "bit_s", "turnaround_s", "gap_s", "slot_s", "timeout_s", "id_retries")
+    __slots__ = ("bit_s", "char_s", "turnaround_s", "gap_s", "slot_s", "timeout_s", "id_retries")
 
     def __init__(self, bus: str) -> None:
-        _master, baud, bits, turnaround_us, gap_chars, timeout_ms, retries = BUSES[bus]
-        self.char_s = bits / baud
+        _master, baud, bits, turnaround_us, idle_gap_chars, timeout_ms, retries = BUSES[bus]
         self.bit_s = 1 / baud
+        self.char_s = bits / baud
         self.turnaround_s = turnaround_us * 1e-6
-        self.gap_s = max(self.turnaround_s, gap_chars * self.char_s)   # spec buses: the frame gap
-        # spec arbitration: one slot = one request frame (no payload) plus turnaround
-        self.slot_s = OVERHEAD * self.char_s + self.turnaround_s
+        # spec buses: the least idle time before any frame, the turnaround and the gap that delimits frames
+        self.gap_s = max(self.turnaround_s, idle_gap_chars * self.char_s)
+        # spec arbitration.slot = request_frame: one request frame (no payload) plus the frame gap
+        self.slot_s = OVERHEAD * self.char_s + self.gap_s
         self.timeout_s = timeout_ms / 1000
         self.id_retries = retries
 
@@ -97,6 +100,10 @@ class Runtime:
         self._slave_out: dict[str, deque[bytes]] = {}
         self._timings: dict[str, BusTiming] = {}
         self._collision_at: dict[str, float] = {}   # bus -> when the last corrupt frame ended
+        self._window_pause: dict[str, float] = {}   # bus -> line time since then taken by frames other than requests
+        self._quiet_until: dict[str, float] = {}    # mastered bus -> the slaves' window after a corrupt frame ends
+        self._slot_used: set[str] = set()           # buses where this slave sent in its slot of the open window
+        self._after_master: dict[str, bool] = {}    # bus -> the last frame heard on it came from its master
 
     def note(self, event: str, **data: Any) -> None:
         """The skeleton's trace notes (a dropped message) go to the board's debug port, like the behaviour's own."""
@@ -124,7 +131,7 @@ class Runtime:
                 on_timeout: Callable[[], None] | None = None, retries: int | None = None,
                 timeout: float | None = None, urgent: bool = False, priority: int = 0) -> None:
         """Queue a transaction on the bus this node masters. `expect`: reply classes; empty: done once sent.
-        `urgent`: ahead of every ordinary one (the latest urgent first). `priority` >= PREEMPT: after those of the
+        `urgent`: ahead of every ordinary one, after the urgent ones queued earlier. `priority` >= PREEMPT: after those of the
         same or a higher priority, ahead of the rest, even of a lower one still waiting out its defer (not yet on
         the wire), which goes back to the queue (spec reflexes, seed 5.2: a reflex does not wait for it)."""
         link = self.links[self.master_bus]  # type: ignore[index]
@@ -139,7 +146,9 @@ class Runtime:
             self._enqueue(link, cur, front=True)
             link.current = req
             return
-        self._enqueue(link, req, front=urgent and priority < PREEMPT)
+        # urgent ones in the order queued, after those queued earlier (the arbitration model's master serves
+        # requests in the order they got through; LIFO starved a sensor, found by tracecheck's K bound)
+        self._enqueue(link, req, front=False)
         if link.current is None:
             self._next(link)
 
@@ -176,6 +185,12 @@ class Runtime:
     def _transmit(self, link: MasterLink, serial: int) -> None:
         req = link.current
         if req is None or req.serial != serial:
+            return
+        quiet = self._quiet_until.get(link.bus, 0.0) - self.now
+        if quiet > 0:
+            # spec arbitration (scope all): after a corrupt frame the slaves own the window's slots; the
+            # arbitration model's master only listens then, and a master frame in a slot costs a slave its turn
+            self.hw.after(quiet, self._transmit, link, serial)
             return
         req.sent = True
         if req.dst == BROADCAST:                  # seed 3.2.1: 0xFF, every node of the bus
@@ -216,6 +231,7 @@ class Runtime:
 
     # --- echo: the transceiver reads back every frame this node sends (seed 3.2.2) --------------
     def on_echo(self, bus: str, sent: bytes, heard: bytes) -> None:
+        self.on_line_frame(bus, heard)
         link = self.links.get(bus)
         if link is not None and link.current is not None and sent == link.frame:
             req, serial = link.current, link.current.serial
@@ -253,22 +269,38 @@ class Runtime:
             self._slave_start(bus)
 
     def _slave_start(self, bus: str) -> None:
-        """seed 3.2.2: send 'when the bus is idle'. Read as: idle for longer than the turnaround, because
-        right after a master's frame the line is idle only until the polled slave's reply starts; a
-        request started there would hit that reply, and again after every backoff (lockstep)."""
+        """seed 3.2.2: a slave starts its own frame only "when the bus is idle". After a master's frame a
+        polled slave's reply starts up to the response timeout later (on the sensor bus the frame gap alone
+        is 6.3 ms), so a request started earlier would hit that reply (found by the trace validator: an
+        XMIT_REQ meeting the SPU's XMIT_RECORD). Idle therefore means: after a frame of the master, for the
+        response timeout, cut to the master_defer_slots the master leaves free (a reply later than that meets
+        the master's next frame anyway); after any other frame, for the frame gap and a character (a master
+        frame already waiting for the line goes first); inside the backoff window after a corrupt frame, for
+        the turnaround (the master keeps off the line); plus two bit times per rank among the bus's
+        requesting slaves, so two slaves waiting for the same idle line start apart and the later one hears
+        the first one's carrier; plus the reflex lead for an ordinary request (reflex_lead_s)."""
         q = self._slave_out.get(bus)
         if not q:
+            return
+        t = self._timing(bus)
+        if self._in_window(bus):
+            quiet = t.turnaround_s
+        elif self._after_master.get(bus, True):
+            # two characters short of the defer: the line is polled a character at a time (below)
+            quiet = min(t.timeout_s, self.net.protocol.master_defer_slots * t.slot_s - 2 * t.char_s)
+        else:
+            quiet = t.gap_s + t.char_s
+        quiet += self.rank(bus) * 2 * t.bit_s + self.reflex_lead_s(bus)
+        idle = self.hw.line_idle_s(bus)
+        if idle <= quiet:                        # first the line, so a frame on it cannot cost our slot
+            self.hw.after(quiet - idle + t.char_s if idle > 0 else t.char_s, self._slave_start, bus)
             return
         wait = self._backoff_wait(bus)
         if wait > 0:
             self.hw.after(wait, self._slave_start, bus)
             return
-        t = self._timing(bus)
-        idle = self.hw.line_idle_s(bus)
-        quiet = t.turnaround_s + self.reflex_lead_s(bus)
-        if idle <= quiet:
-            self.hw.after(quiet - idle + t.char_s if idle > 0 else t.char_s, self._slave_start, bus)
-            return
+        if self._in_window(bus):
+            self._slot_used.add(bus)             # one request per slot: the next waits for the window's end
         self.transmit(bus, q[0])  # type: ignore[attr-defined]
 
     def reflex_request(self, bus: str) -> bool:
@@ -277,12 +309,12 @@ class Runtime:
         return self.net.reflex_from(self.address) is not None  # type: ignore[attr-defined]
 
     def reflex_lead_s(self, bus: str) -> float:
-        """seed 5.2 / spec arbitration reflex_lead_bits: an ordinary request waits for the frame gap plus this
-        many bit times, so a reflex request started at the gap is on the line first and the other defers."""
+        """seed 5.2 / spec arbitration reflex_lead_bits: an ordinary request waits this many bit times longer
+        than a reflex one would in the same idle stretch, so the reflex is on the line first and the other
+        hears its carrier and defers."""
         if not self.net.reflexes or self.reflex_request(bus):
             return 0.0
-        t = self._timing(bus)
-        return t.gap_s - t.turnaround_s + self.net.reflex_lead_bits * t.bit_s
+        return self.net.reflex_lead_bits * self._timing(bus).bit_s
 
     def _slave_echo(self, bus: str, sent: bytes, heard: bytes) -> None:
         q = self._slave_out.get(bus)
@@ -293,7 +325,7 @@ class Runtime:
             if q:
                 self._slave_start(bus)
         elif self._scope_all(bus):
-            self._collision_at[bus] = self.now   # seed 3.2.2: corrupt echo; spec: wait for our slot
+            self._open_window(bus)               # seed 3.2.2: corrupt echo; spec: wait for our slot
             self._slave_start(bus)
         else:
             self.hw.after(self._backoff(bus), self._slave_start, bus)
@@ -301,7 +333,35 @@ class Runtime:
     def on_codec_error(self, bus: str, err: Any) -> None:
         """A corrupt frame on one of our buses: with scope `all`, every slave enters the backoff window."""
         if self._scope_all(bus) and bus != self.master_bus:
-            self._collision_at[bus] = self.now
+            self._open_window(bus)
+
+    def _open_window(self, bus: str) -> None:
+        self._collision_at[bus] = self.now
+        self._window_pause[bus] = 0.0
+        self._slot_used.discard(bus)
+
+    def on_line_frame(self, bus: str, data: bytes) -> None:
+        """Every frame the UART hears on a bus, ended just now (the receiver's byte stream, own frames by
+        their echo). The window's slots are idle slots (spec arbitration rule): a frame other than a
+        request, e.g. the master serving one, does not use up a slot, so the window stands still."""
+        try:
+            _dst, src, opcode, _payload = check(data)
+        except CodecError:
+            src = opcode = None
+        if bus != self.master_bus:                   # a reply may follow the master's frame
+            self._after_master[bus] = src is None or src == ADDRESS_OF[BUSES[bus][0]]
+        if not self._scope_all(bus):
+            return
+        if opcode is None:
+            if bus == self.master_bus:               # the slaves contend now: the master keeps off the line
+                self._quiet_until[bus] = self.now + self._master_resend_wait(self.links[bus])
+            else:
+                self._open_window(bus)               # any corrupt frame, our own echo included
+            return
+        if bus == self.master_bus:
+            return
+        if bus in self._collision_at and opcode != self.net.request_opcodes.get(bus):
+            self._window_pause[bus] += len(data) * self._timing(bus).char_s
 
     def _scope_all(self, bus: str) -> bool:
         return self.net.arbitration.get(bus) == "address_backoff" and self.net.backoff_scope == "all"
@@ -312,16 +372,30 @@ class Runtime:
         at = self._collision_at.get(bus)
         if at is None or not self._scope_all(bus):
             return 0.0
+        at += self._window_pause.get(bus, 0.0)     # idle slots: the window stood still while others talked
         t = self._timing(bus)
         slaves = self.net.requesters.get(bus, ())   # spec: rank among the bus's requesting slaves
         step = self.net.backoff_slots * t.slot_s
         mine, end = at + self.rank(bus) * step, at + len(slaves) * step
         now = self.now
+        if now >= end:
+            return 0.0
+        if bus in self._slot_used:
+            return end - now
         if now < mine:
             return mine - now
-        if now < mine + step or now >= end:
+        if now < mine + step:
             return 0.0
         return end - now
+
+    def _in_window(self, bus: str) -> bool:
+        """The backoff window after a corrupt frame is still open (scope all), in idle slots."""
+        at = self._collision_at.get(bus)
+        if at is None or not self._scope_all(bus):
+            return False
+        t = self._timing(bus)
+        window = len(self.net.requesters.get(bus, ())) * self.net.backoff_slots * t.slot_s
+        return self.now < at + self._window_pause.get(bus, 0.0) + window
 
     def _timing(self, bus: str) -> BusTiming:
         t = self._timings.get(bus)
@@ -334,7 +408,7 @@ class Runtime:
         t = self._timing(bus)
         if self.net.arbitration.get(bus) != "address_backoff":
             return t.turnaround_s
-        return (self.rank(bus) + 1) * t.slot_s
+        return (self.rank(bus) + 1) * self.net.backoff_slots * t.slot_s
 
     def rank(self, bus: str) -> int:
         """This slave's arbitration rank on `bus` (spec rank_order: declared priority, then address)."""

@@ -81,38 +81,7 @@ class AlarmLimit:
         return False
 
 
-class AfterReplies(Runtime):
-    """seed 3.2.2: a slave starts its own frame only "when the bus is idle". A polled slave's reply starts
-    up to the response timeout after the master's request (on the sensor bus the frame gap alone is 6.3 ms),
-    so a DATA_RDY or XMIT_REQ started earlier would hit that reply, and the master's resend after it. Idle
-    here means idle for longer than the bus's response timeout (spec), when no reply can be due any more,
-    plus two bit times per rank among the bus's requesting slaves (spec order), plus the reflex lead for an
-    ordinary request: two sensors waiting for the same idle line start apart, so the later one hears the
-    first one's carrier and waits. Only where the master's defer leaves room for that wait (the sensor bus);
-    elsewhere (the SPU on the first-level bus) the plain rule of Runtime applies."""
-
-    def _slave_start(self, bus: str) -> None:
-        t = self._timing(bus)
-        # seed 5.2 / spec reflexes: a reflex request leads every other one by reflex_lead_bits; the rank stagger
-        # gives that lead already to every slave ranked behind the reflex source (the TPSC ranks first)
-        rank = self.rank(bus)
-        reflex_ranks = [i for i, a in enumerate(self.net.requesters.get(bus, ())) if self.net.reflex_from(a)]
-        behind = rank - min(reflex_ranks) if reflex_ranks and not self.reflex_request(bus) else None
-        lead = 0.0 if behind is None else max(0, self.net.reflex_lead_bits - 2 * behind) * t.bit_s
-        quiet = t.timeout_s + rank * 2 * t.bit_s + lead
-        if quiet >= self.net.protocol.master_defer_slots * t.slot_s:
-            # the master's next frame would start first (first-level bus: its defer is shorter than the
-            # timeout): the plain rule, so a reflex request still gets the next idle stretch (seed 5.2)
-            super()._slave_start(bus)
-            return
-        idle = self.hw.line_idle_s(bus)
-        if self._slave_out.get(bus) and idle <= quiet:
-            self.hw.after(quiet - idle + t.char_s if idle > 0 else t.char_s, self._slave_start, bus)
-            return
-        super()._slave_start(bus)
-
-
-class _Sensor(AfterReplies):
+class _Sensor(Runtime):
     """What the sensor controllers share: the SPU as master, DATA_RDY announcements, SET_ALARM limits."""
 
     def start(self) -> None:
@@ -303,7 +272,7 @@ class IRRC(_RangeSensor, IrrcSkeleton):
         self.send(src, M.XmitDataIrrc(left=left, center=center, right=right))
 
 
-class TPSC(AfterReplies, TpscSkeleton):
+class TPSC(Runtime, TpscSkeleton):
     """seed 3.2.12: the TPSC always initiates: DATA_RDY when a whisker touches."""
 
     def start(self) -> None:

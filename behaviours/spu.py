@@ -24,8 +24,8 @@ from arachnae_proto.skeletons.spu import SpuSkeleton
 
 from behaviours import tuning as T
 from behaviours.post import PostMaster
-from behaviours.runtime import PRIORITY_REFLEX, slaves_of
-from behaviours.sensors import ABOVE, BELOW, BEYOND, AfterReplies, AlarmLimit, limit_in
+from behaviours.runtime import PRIORITY_REFLEX, Runtime, slaves_of
+from behaviours.sensors import ABOVE, BELOW, BEYOND, AlarmLimit, limit_in
 from behaviours.units import XMIT_DATA_OF, quantizer, record_byte
 
 # each sensor role's STATUS_ACK layout; the range sensors are the ones with UNRELIABLE (3.2.11, 3.2.13)
@@ -73,7 +73,7 @@ def alarm_setup() -> list[tuple[str, M.Message, list[tuple[int, AlarmLimit]]]]:
     return out
 
 
-class SPU(PostMaster, AfterReplies, SpuSkeleton):
+class SPU(PostMaster, Runtime, SpuSkeleton):
     def start(self) -> None:
         self.sensors = {NODES[a][1]: a for a in slaves_of(self.master_bus)}
         self.live: list[str] = []
@@ -165,13 +165,13 @@ class SPU(PostMaster, AfterReplies, SpuSkeleton):
                          lambda role=role: self.missed(role), urgent=True)
             return
         event = role != "TPSC"                     # anything else announces an alarm or a status change
+        if role in RANGE:                          # its status first: is the data to be trusted (6.2)
+            self.request(src, M.StatusReq(), (STATUS_OF[role],), lambda s, m, role=role: self.set_status(role, m.status),
+                         lambda role=role: self.missed(role), urgent=True)
         # spec reflexes (seed 5.2): a reflex source's data is fetched before anything still waiting out its defer
         self.request(src, M.XmitData(), (XMIT_DATA_OF[role],), lambda s, m, role=role: self.got(role, m, event),
                      lambda role=role: self.missed(role), urgent=True,
                      priority=PRIORITY_REFLEX if self.net.reflex_from(src) is not None else 0)
-        if role in RANGE:                          # urgent: goes before the XMIT_DATA just queued
-            self.request(src, M.StatusReq(), (STATUS_OF[role],), lambda s, m, role=role: self.set_status(role, m.status),
-                         lambda role=role: self.missed(role), urgent=True)
 
     # --- what the sensors said -------------------------------------------------------------
     def set_status(self, role: str, code: int) -> None:

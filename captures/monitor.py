@@ -13,9 +13,10 @@ message, last value of every field, errors by kind). `--pcapng FILE` writes
 each frame through captures.pcapng and flushes it, so a monitor that is
 interrupted leaves a capture Wireshark opens.
 
-HOOK(issue 11, trace validator): the --pcapng file is a capture like a
-simulation's bus.pcapng; `arachnae trace check` is meant to read it. Nothing
-here validates traces.
+The --pcapng file is a capture like a simulation's bus.pcapng:
+`arachnae trace check FILE` (tracecheck) holds it to the verified protocol,
+with `--untimed` when the tap's time stamps are not the line's (a pty, a
+buffering USB adapter). Nothing here validates traces.
 """
 from __future__ import annotations
 

@@ -5,7 +5,7 @@ import json
 from typing import Any
 
 from arachnae.errors import UserError
-from model_check import msc, spec_adapter
+from model_check import msc, replay, spec_adapter
 from model_check.engine import Result, explore
 from model_check.gcl import Model
 from model_check.models import arbitration, id_retry, post, reaction
@@ -112,6 +112,13 @@ def text(res: Result) -> str:
     return "\n".join(lines)
 
 
+def command_line(args) -> str:
+    """The `arachnae check` command that found a counterexample, for the replay's header."""
+    opts = [f"--{k} {v}" for k, v in (("variant", args.variant), ("bus", args.bus), ("size", args.size),
+                                       ("scope", args.scope)) if v is not None]
+    return " ".join(["arachnae check", args.model] + opts)
+
+
 def run_check(args) -> int:
     spec = spec_adapter.load(args.spec)
     if args.variant == "seed" and args.model not in ("arbitration", "all"):
@@ -126,6 +133,9 @@ def run_check(args) -> int:
         res.release()              # the graph is no longer needed: keep memory flat over `check all`
         if not args.json:
             print(text(res), flush=True)
+        if getattr(args, "replay", None) and res.violation is not None:
+            for path in replay.write(res, args.replay, command_line(args)):
+                print(f"  replay: {path}  (run: arachnae sim run {path})", flush=True)
         if args.promela:
             from model_check import promela
             path = f"{args.promela.rstrip('/')}/{model.name.split('[')[0]}_{len(results)}.pml"

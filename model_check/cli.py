@@ -22,6 +22,8 @@ def register(sub) -> None:
     c.add_argument("--legs", type=_positive, default=None, help="POST: use only the first N legs")
     c.add_argument("--no-symmetry", action="store_true", help="POST: explore without symmetry reduction")
     c.add_argument("--promela", metavar="DIR", default=None, help="also write the Promela of each model to DIR")
+    c.add_argument("--replay", metavar="DIR", default=None,
+                   help="write each arbitration counterexample as a sim2d scenario in DIR (real node code)")
     c.add_argument("--spec", default=None, help="spec directory (default: the repository's spec/)")
     c.add_argument("--json", action="store_true", help="print the results as JSON")
     c.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
@@ -48,7 +50,7 @@ _OPTIONS = {
     "arbitration": {"variant", "scope", "bus", "size"},
     "id_retry": {"bus", "size"},
     "post": {"legs", "no_symmetry"},
-    "reaction": {"size"},
+    "reaction": {"size"},          # --size: other slaves kept per bus (build_models: others)
     "all": {"variant", "scope", "size", "legs", "no_symmetry"},
 }
 _DEFAULTS = {"variant": "spec", "scope": None, "bus": None, "size": None, "legs": None, "no_symmetry": False}

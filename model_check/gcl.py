@@ -92,6 +92,7 @@ class Model:
     bound_ms: float | None = None            # the spec's bound on the responses' worst case (requirements)
     bound_section: str = ""
     notes: list[str] = field(default_factory=list)
+    origin: dict[str, str] = field(default_factory=dict)     # what it was built from (model, bus, variant)
     participants: list[str] = field(default_factory=list)   # MSC column order
     # Named subexpressions over the variables, evaluated once per state (Promela: #define).
     defs: list[tuple[str, str]] = field(default_factory=list)

@@ -77,11 +77,15 @@ def frame_us(spec, bus: str, message: str) -> float:
     return spec.frame_time_us(bus, m.max_size) + b.frame_gap_us
 
 
+def first_byte_timeout_us(spec, bus: str) -> float:
+    """seed 3.2.2: a reply must begin (first_byte) or be complete (last_byte) this long after the request."""
+    return spec.buses[bus].response_timeout_ms * 1000.0
+
+
 def response_window_us(spec, bus: str) -> float:
     """How long a master waits for a reply: seed 3.2.2's timeout, to the reply's first byte when the
     spec says so (protocol.response_timeout_to), then for the rest of the longest ID_ACK."""
-    b = spec.buses[bus]
-    window = b.response_timeout_ms * 1000.0
+    window = first_byte_timeout_us(spec, bus)
     if spec.protocol.response_timeout_to == "first_byte":
         window += spec.frame_time_us(bus, need_message(spec, "ID_ACK").max_size)
     return window

@@ -7,6 +7,11 @@ station, senders included, then hears the wired-AND of both frames. Each
 sender hears its own frame back (the echo the seed uses to detect
 corruption). Loss, corruption and delay can be injected per bus; a station
 can be muted (its transmitter is dead) or killed (it neither hears nor talks).
+Stations can be made deaf to each other's requests for one character time:
+their requests started that close together then collide instead of deferring
+by carrier sense (the slaves' rank stagger is a few bit times), which is the
+arbitration model's collision of requests sent in the same slot (a checker's
+counterexample replays with it, model_check.replay).
 """
 from __future__ import annotations
 
@@ -98,6 +103,8 @@ class Bus:
         self.busy_since = 0.0
         self.fault = Fault()
         self.stats = BusStats()
+        self.deaf: frozenset[str] = frozenset()     # stations that miss each other's request carrier
+        self.deaf_opcode: int | None = None         # ... for frames with this opcode (the bus's request)
 
     def attach(self, owner: str, receiver: Receiver, echo: Echo | None = None) -> Port:
         port = Port(self, owner, receiver, echo)
@@ -110,9 +117,20 @@ class Bus:
     def idle(self) -> bool:
         return not self.active and self.sched.now >= self.idle_at
 
-    def idle_for(self) -> float:
-        """Seconds since the line went idle; 0.0 while a frame is on it."""
+    def idle_for(self, owner: str | None = None) -> float:
+        """Seconds since the line went idle; 0.0 while a frame is on it (that `owner` can hear)."""
+        if self.active and self._unheard(owner, self.deaf_opcode):
+            return self.sched.now - self.idle_at
         return self.sched.now - self.idle_at if not self.active and self.sched.now >= self.idle_at else 0.0
+
+    def _unheard(self, owner: str | None, opcode: int | None) -> bool:
+        """`owner`, about to send a request, cannot hear what is on the line: requests of stations it is
+        deaf to, begun less than a character time ago."""
+        if owner not in self.deaf or opcode is None or opcode != self.deaf_opcode:
+            return False
+        now = self.sched.now
+        return all(tx.port.owner in self.deaf and tx.port.owner != owner and len(tx.data) > 2
+                   and tx.data[2] == opcode and now - tx.start < self.char_time for tx in self.active)
 
     def _schedule_start(self, port: Port) -> None:
         t = max(self.sched.now, self.idle_at + self.turnaround if self.idle_at > 0 else self.sched.now)
@@ -124,7 +142,7 @@ class Bus:
             port._pending = False
             port.queue.clear()
             return
-        if self.active:
+        if self.active and not self._unheard(port.owner, port.queue[0][2] if len(port.queue[0]) > 2 else None):
             first = min(tx.start for tx in self.active)
             if now - first >= self.bit_time:
                 port._pending = False   # carrier sensed: _finish() reschedules waiting ports

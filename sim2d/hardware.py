@@ -42,7 +42,7 @@ class NodeHardware:
             self.ports[bus].send(data)
 
     def line_idle_s(self, bus: str) -> float:
-        return self.ports[bus].bus.idle_for()
+        return self.ports[bus].bus.idle_for(self.node.short)
 
     def note(self, event: str, **data: Any) -> None:
         self.sim.on_note(self.node, event, data)

@@ -9,6 +9,9 @@ from typing import TYPE_CHECKING, Any, Sequence
 from sim2d.gait_metrics import motion_schema
 from sim2d.nav_metrics import nav_schema
 
+from tracecheck.trace import COLUMNS, parse_lines, trace_lines
+from tracecheck.validate import validate
+
 if TYPE_CHECKING:
     from sim2d.robot import Robot
     from sim2d.sim import Simulation, TraceEntry
@@ -133,6 +136,12 @@ def metrics_schema(spec: Any, measured: Sequence[str] = ()) -> dict[str, Any]:
         "nodes": _obj({n.short: _FREE for n in spec.nodes}),
         "motion": motion_schema(),
         **nav_schema(measured),
+        # tracecheck.validate.Report.metrics: the run's trace held to the verified protocol (issue 11)
+        "protocol": _obj({**{k: _VALUE for k in ("violations", "first", "requests", "served", "declined",
+                                                 "unchecked", "starved")},
+                          "by_rule": {"type": "object", "additionalProperties": _VALUE},
+                          **{k: _obj({b: _VALUE for b in spec.buses}) for k in ("max_wait_slots", "k_slots")},
+                          "checked": {"type": "object", "additionalProperties": _VALUE}}),
         "reactions": {"type": "array"},         # one record per reaction (the report's sequence charts)
         "expectations": {"type": "array"},      # added by the runner to metrics.json
     })
@@ -236,7 +245,15 @@ def build_metrics(sim: "Simulation") -> dict[str, Any]:
         "motion": motion_metrics(sim),           # sim2d.gait_metrics: body-frame motion per (gait, MOVE)
         **nav_metrics(sim),                      # sim2d.nav_metrics: coverage, wall_band (scenario `measure:`)
         "trace_hash": trace_hash(sim.frames, sim.poses),
+        "protocol": protocol_metrics(sim),
     }
+
+
+def protocol_metrics(sim: "Simulation") -> dict[str, Any]:
+    """The run's bus trace held to the verified protocol (tracecheck): violations (0 expected), waits, K."""
+    lines = ["\t".join(COLUMNS)] + trace_lines(sim.frames, sim.notes)
+    trace = parse_lines(lines, f"{sim.scenario.name}/trace.tsv", set(sim.spec.buses))
+    return validate(trace, sim.spec, dict(sim.scenario.arbitration)).metrics()
 
 
 def check_expectations(scenario: Any, m: dict[str, Any]) -> list[tuple[str, bool, str]]:
@@ -268,6 +285,11 @@ def check_expectations(scenario: Any, m: dict[str, Any]) -> list[tuple[str, bool
     if e.stay_out is not None:
         t = m["entered_forbidden_s"]
         out.append(("stay_out", t is None, "never entered the region" if t is None else f"entered the region at {t} s"))
+    if "protocol.violations" not in (e.metrics or {}) and "protocol" in m:
+        # issue 11: every run is a behaviour the verified protocol allows
+        p = m["protocol"]
+        out.append(("protocol.violations eq", p["violations"] == 0,
+                    f"protocol.violations = {p['violations']}, eq 0" + (f"; first: {p['first']}" if p["first"] else "")))
     for path, bounds in (e.metrics or {}).items():
         v = lookup(m, path)
         for op, limit in bounds.items():

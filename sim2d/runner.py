@@ -19,7 +19,8 @@ from arachnae.errors import UserError
 from sim2d.level0_io import WallClock, attach_console
 from sim2d.metrics import check_expectations
 from sim2d.scenario import Scenario, load_scenario
-from sim2d.sim import Result, Simulation, capture_frames, trace_lines
+from sim2d.sim import Result, Simulation, capture_frames
+from tracecheck.trace import COLUMNS, trace_lines
 
 GIF_FRAME_S = 0.5
 RUN_MARKER = ".arachnae-run"        # in every run folder: {"scenario", "name", "seed"} as JSON
@@ -114,9 +115,9 @@ def write_outputs(outcome: Outcome, out_dir: str | Path, gif: bool = False, forc
         raise UserError(f"--out {out}: cannot create the output folder ({exc.strerror})") from None
     try:
         r = outcome.result
-        lines = trace_lines(r.frames)
+        lines = trace_lines(r.frames, r.notes)
         with open(tmp / "trace.tsv", "w") as fh:
-            fh.write("start_s\tend_s\tbus\tsender\tsrc\tdst\tmessage\tbytes\tflags\n")
+            fh.write("\t".join(COLUMNS) + "\n")
             fh.write("\n".join(lines) + ("\n" if lines else ""))
         # the same frames for Wireshark: one interface per bus, the spec's user link type (issue 13)
         write_file(tmp / "bus.pcapng", bus_interfaces(outcome.spec or load_spec_once()), capture_frames(r.frames))

@@ -32,7 +32,8 @@ from sim2d.metrics import metric_node, metrics_schema
 from sim2d.robot_params import DEFAULT as DEFAULT_PARAMS
 
 LIST_KEYS = ("walls", "obstacles", "pits", "slopes", "lights", "heat", "sounds", "faults", "operator")
-MAP_KEYS = ("arena", "robot", "expect", "measure", "speech")
+MAP_KEYS = ("arena", "robot", "expect", "measure", "speech", "arbitration")
+FAULT_KINDS = ("kill", "mute", "bus", "sensor", "request", "collide")   # scenario.schema.yaml faults
 _SCHEMA: dict[str, Any] = yaml.safe_load((Path(__file__).with_name("scenario.schema.yaml")).read_text())
 
 
@@ -90,13 +91,14 @@ def _rcp_keys_check(keys: str) -> str | None:
 class Fault:
     at: float
     until: float | None
-    kind: str                 # kill | mute | bus | sensor
+    kind: str                 # one of FAULT_KINDS
     node: str | None = None
     bus: str | None = None
     loss: float = 0.0
     corrupt: float = 0.0
     delay: float = 0.0
     noise: float = 0.0        # sensor: extra spread (1 sigma) of every reading, in the sensor's unit
+    nodes: tuple[str, ...] = ()   # collide: the stations deaf to each other for a slot
 
 
 @dataclass(frozen=True)
@@ -149,16 +151,21 @@ class Scenario:
     battery_charge: float = 1.0                # state of charge at power-on
     battery_ah: float | None = None            # battery capacity; None: the robot's (sim2d.robot_params)
     contention: Contention | None = None       # every slave of a bus requests as a stimulus fires
+    arbitration: dict[str, str] = field(default_factory=dict)   # bus -> 'seed' | 'spec' (replays of the checker)
 
     def with_seed(self, seed: int) -> "Scenario":
         from dataclasses import replace
         return replace(self, seed=seed)
 
 
-def _fault_problem(f: dict) -> str | None:
-    kinds = [k for k in ("kill", "mute", "bus", "sensor") if f.get(k) is not None]
+def _fault_problem(f: dict, bus_of: dict[str, str | None]) -> str | None:
+    kinds = [k for k in FAULT_KINDS if f.get(k) is not None]
     if len(kinds) != 1:
-        return "a fault names exactly one of kill, mute, bus or sensor"
+        return f"a fault names exactly one of {', '.join(FAULT_KINDS)}"
+    if kinds[0] == "request" and f.get("until") is not None:
+        return "a request happens at one time: no until"
+    if kinds[0] == "collide" and bus_of and len({bus_of.get(n) for n in f["collide"]}) != 1:
+        return "collide: the nodes must share one bus"
     if (kinds[0] == "sensor") != (f["noise"] > 0):
         return "a sensor fault needs noise > 0" if kinds[0] == "sensor" else "noise belongs to a sensor fault"
     if kinds[0] == "bus" and not (f["loss"] or f["corrupt"] or f["delay"]):
@@ -176,6 +183,11 @@ def _schema(spec: Any) -> dict[str, Any]:
     if spec is not None:
         schema["$defs"]["node"] = {"enum": [n.short for n in spec.nodes]}
         schema["$defs"]["bus"] = {"enum": sorted(spec.buses)}
+        contended = sorted(b for b, x in spec.buses.items() if x.request_message)
+        schema["$defs"]["requester"] = {"enum": [n.short for b in contended for n in spec.requesters(b)]}
+        arb = schema["properties"]["arbitration"]
+        arb["properties"] = {b: arb["additionalProperties"] for b in contended}
+        arb["additionalProperties"] = False
     return schema
 
 
@@ -321,8 +333,9 @@ def _check_meaning(doc: LDict, spec: Any) -> None:
             if item["at"] >= duration:
                 raise locate(doc, [key, i, "at"], f"{key}[{i}].at: {item['at']} s is not before the end of the run "
                                                   f"({duration} s)")
+    bus_of = {n.short: n.bus for n in spec.nodes} if spec is not None else {}
     for i, f in enumerate(doc.get("faults", [])):
-        problem = _fault_problem(f)
+        problem = _fault_problem(f, bus_of)
         if problem:
             raise locate(doc, ["faults", i], f"faults[{i}]: {problem}")
     for i, o in enumerate(doc.get("operator", [])):
@@ -445,9 +458,10 @@ def _build(v: dict[str, Any], shown: str) -> Scenario:
                 m["region"] = _poly(m["region"])
     faults = tuple(
         Fault(at=float(f["at"]), until=None if f.get("until") is None else float(f["until"]),
-              kind="kill" if f.get("kill") else "mute" if f.get("mute") else "sensor" if f.get("sensor") else "bus",
-              node=f.get("kill") or f.get("mute") or f.get("sensor"), bus=f.get("bus"), loss=float(f["loss"]),
-              corrupt=float(f["corrupt"]), delay=float(f["delay"]), noise=float(f["noise"]))
+              kind=next(k for k in FAULT_KINDS if f.get(k) is not None),
+              node=f.get("kill") or f.get("mute") or f.get("sensor") or f.get("request") or (f.get("collide") or [None])[0],
+              bus=f.get("bus"), loss=float(f["loss"]), corrupt=float(f["corrupt"]), delay=float(f["delay"]),
+              noise=float(f["noise"]), nodes=tuple(f.get("collide") or ()))
         for f in v.get("faults", [])
     )
     x, y, heading = (float(c) for c in robot["pose"])
@@ -489,6 +503,7 @@ def _build(v: dict[str, Any], shown: str) -> Scenario:
         battery_charge=float(robot["battery_charge"]),
         battery_ah=_opt(robot.get("battery_ah")),
         contention=Contention(v["contention"]["bus"], v["contention"]["stimulus"]) if v.get("contention") else None,
+        arbitration=dict(v.get("arbitration", {})),
     )
 
 

@@ -17,10 +17,10 @@ from typing import Any, Callable
 
 from arachnae_proto import CodecError
 from arachnae_proto.frame import check
+from arachnae_proto.messages import BY_NAME as MESSAGES
 from arachnae_proto.network import BROADCAST
 
 from behaviours import behaviour_class
-from captures.decode import decode
 from captures.pcapng import CapturedFrame
 from behaviours.netconfig import Config, NetConfig
 from behaviours.post import Verdict
@@ -58,6 +58,7 @@ class Result:
     robot: Robot
     frames_png: list = field(default_factory=list)
     nodes: dict = field(default_factory=dict)      # short name -> node (for its debug-port artifacts)
+    notes: list = field(default_factory=list)      # debug-port notes: (t, node, event, data)
 
 
 class _Intact:
@@ -92,10 +93,13 @@ def _receiver(node: Runtime, hw: NodeHardware, intact: _Intact = _INTACT) -> Any
     """
     own = node.address
     receive = node.receive
+    heard = getattr(node, "on_line_frame", None)      # the UART hears every frame on the line
 
     def deliver(bus: str, t: float, data: bytes) -> None:
         if not hw.alive:
             return
+        if heard is not None:
+            heard(bus, data)
         if data and data[0] != own and data[0] != BROADCAST and intact(data):
             return
         receive(bus, data)              # ours, broadcast, or bad: the skeleton parses (and reports) it
@@ -134,7 +138,11 @@ class Simulation:
             # spec buses: no frame starts before the line was idle for the frame gap (turnaround, idle gap)
             self.buses[name] = Bus(name, self.sched, b.baud, b.bits_per_char, b.frame_gap_us * 1e-6,
                                    stream(scenario.seed, f"bus:{name}"), self._trace)
-        self.config = Config(NetConfig.from_spec(spec), geometry=params, task=scenario.task)
+        net = NetConfig.from_spec(spec)
+        if scenario.arbitration:       # a replay of the checker's seed variant runs the seed's rule on that bus
+            seed = {b: "seed" for b, v in scenario.arbitration.items() if v == "seed"}
+            net = replace(net, arbitration={**net.arbitration, **seed})
+        self.config = Config(net, geometry=params, task=scenario.task)
         self.nodes: dict[str, Runtime] = {}
         self.hardware: dict[str, NodeHardware] = {}
         self.verdict: Verdict | None = None
@@ -218,6 +226,13 @@ class Simulation:
                 self.sched.at(f.at, self.sensors.set_fault, f.node, f.noise)
                 if f.until is not None:
                     self.sched.at(f.until, self.sensors.set_fault, f.node, 0.0)
+            elif f.kind == "request":
+                self.sched.at(f.at, self._request, f.node)
+            elif f.kind == "collide":
+                bus = self.spec.node(f.node).bus
+                self.sched.at(f.at, self._set_deaf, bus, frozenset(f.nodes))
+                if f.until is not None:
+                    self.sched.at(f.until, self._set_deaf, bus, frozenset())
             elif f.kind == "bus":
                 self.sched.at(f.at, self._set_bus_fault, f.bus, BusFault(f.loss, f.corrupt, f.delay))
                 if f.until is not None:
@@ -233,6 +248,18 @@ class Simulation:
     def _fault_note(self, f: Any) -> None:
         """The fault's start in the notes (metrics notes.fault_injected: what happened after it)."""
         self.notes.append((self.sched.now, "sim", "fault_injected", {"kind": f.kind, "node": f.node, "bus": f.bus}))
+
+    def _request(self, short: str) -> None:
+        """The node asks for its bus (its request_message to its master), as when a record becomes pending."""
+        node, n = self.nodes.get(short), self.spec.node(short)
+        if node is None or not self.hardware[short].alive:
+            return
+        b = self.spec.buses[n.bus]
+        node.slave_send(self.spec.node(b.master).address, MESSAGES[b.request_message]())
+
+    def _set_deaf(self, bus: str, nodes: frozenset[str]) -> None:
+        b = self.buses[bus]
+        b.deaf, b.deaf_opcode = nodes, MESSAGES[self.spec.buses[bus].request_message].OPCODE
 
     def _set_bus_fault(self, bus: str, fault: BusFault) -> None:
         self.buses[bus].fault = fault
@@ -300,22 +327,7 @@ class Simulation:
         from sim2d.metrics import build_metrics
         metrics = build_metrics(self)
         return Result(self.scenario, self.verdict, self.frames, self.poses, metrics, metrics["trace_hash"],
-                      self.sensors, self.world, self.robot, self.snapshots, self.nodes)
-
-
-def trace_lines(frames: list[TraceEntry]) -> list[str]:
-    """One tab-separated line per frame: start, end, bus, sender, src, dst, message, bytes, flags.
-
-    The message column is what the generated codec parses from the bytes heard
-    (arachnae_proto.frame.parse, Message.describe()); a frame it rejects shows
-    the codec's reason.
-    """
-    out = []
-    for f in frames:
-        data = f.heard if f.heard is not None else f.sent
-        d = decode(data)
-        out.append(f"{f.start:.6f}\t{f.end:.6f}\t{f.bus}\t{f.sender}\t{d.src}\t{d.dst}\t{d.text}\t{data.hex()}\t{','.join(f.flags)}")
-    return out
+                      self.sensors, self.world, self.robot, self.snapshots, self.nodes, self.notes)
 
 
 def capture_frames(frames: list[TraceEntry]) -> list[CapturedFrame]:

@@ -12,7 +12,8 @@ from pathlib import Path
 from typing import Any, Iterable
 
 COLUMNS = ("scenario", "seed", "pass", "POST", "walked m", "collisions", "min clear m", "max react s",
-           "control s (reflex/avoid/task)", "battery V min/mean/end", "PSC V low mean/level, alarms", "notes")
+           "control s (reflex/avoid/task)", "battery V min/mean/end", "PSC V low mean/level, alarms", "notes",
+           "protocol violations; wait/K slots")
 _NOTES = ("escape", "five_legged_gait", "operator_message", "blocked", "pit", "led_blink", "speech")
 
 
@@ -41,6 +42,16 @@ def _battery(m: dict[str, Any]) -> tuple[str, str]:
     return _volts(b.get("v_min"), b.get("v_mean"), b.get("v_final")), psc
 
 
+def _protocol(m: dict[str, Any]) -> str:
+    """Issue 11: the run's trace against the verified protocol: violations, then each contended bus's longest
+    wait against the checker's bound K."""
+    p = m.get("protocol")
+    if not p:
+        return "-"
+    waits = " ".join(f"{b} {w:.1f}/{p['k_slots'].get(b)}" for b, w in p.get("max_wait_slots", {}).items())
+    return f"{p['violations']}; {waits}" if waits else str(p["violations"])
+
+
 def row(m: dict[str, Any]) -> list[str]:
     exps = m.get("expectations", [])
     ok = all(e["passed"] for e in exps)
@@ -48,7 +59,7 @@ def row(m: dict[str, Any]) -> list[str]:
     clear = m.get("min_clearance_m")
     return [m["scenario"], str(m["seed"]), "PASS" if ok else "FAIL", str(m["post"]["verdict"]),
             f"{m['distance_walked_m']:.2f}", str(m["collisions"]), "-" if clear is None else f"{clear:.2f}",
-            "-" if r is None else f"{r:.2f}", _control(m), *_battery(m), _notes(m)]
+            "-" if r is None else f"{r:.2f}", _control(m), *_battery(m), _notes(m), _protocol(m)]
 
 
 def markdown(metrics: Iterable[dict[str, Any]]) -> str:

@@ -18,6 +18,26 @@ Variant `spec`: the spec's collision rule, in one of two scopes:
   (a contention window of n * backoff_slots idle slots); after the window
   anyone may send again. Distinct ranks make collisions inside a window
   impossible, whether the requests are old or new.
+
+The send rule (`send_guard`) and the backoff a collision sets
+(`collision_backoff`) are module-level so that the trace validator
+(tracecheck) evaluates the very same expressions on a simulated or captured
+bus trace instead of restating them.
+
+Abstracted away, and checked on traces by tracecheck instead:
+- the master's own transactions (polls, commands, POST, master_defer_slots):
+  they occupy the line without changing any slave's state; the validator
+  counts a request's wait and the window's slots without them;
+- losses and line noise other than collisions: a request whose service met a
+  lost or noise-corrupted frame is not held to the bound K;
+- MOVE relay retries (protocol.move_retries) and record forwarding through
+  the MCP: here one `delivered_X` step stands for the relay; the validator
+  checks that every record reaching the MCP is relayed to its target and that
+  MOVE_RELAYED is resent at most move_retries times, each after a STATUS_ACK
+  that did not show the command applied;
+- the sub-masters' relays (SPU, MMC, LCP) live on their own buses, which are
+  polled (no contention to model) or modelled here as the sensor bus; the
+  validator checks their exchanges with the one-talker and timeout rules.
 """
 from __future__ import annotations
 
@@ -27,17 +47,42 @@ from model_check.spec_adapter import ArbParams
 
 IDLE, PENDING, SESSION = 0, 1, 2
 M_IDLE, M_FETCH, M_DELIVER = 0, 1, 2
+VARIANTS = ("seed", "spec")
+
+
+def window_slots(p: ArbParams, n: int) -> int:
+    """Scope `all`: the contention window after a collision, n ranks of backoff_slots idle slots each."""
+    return n * p.backoff_slots
+
+
+def collision_backoff(p: ArbParams, rank: int) -> int:
+    """Scope `colliders`: slots a slave that read a corrupt echo waits (spec arbitration.address_backoff)."""
+    return (rank + 1) * p.backoff_slots
+
+
+def send_guard(p: ArbParams, variant: str, i: int, rank: int, n: int) -> str:
+    """When slave i (rank `rank`, one of n) may start its request, over ph{i}, bo{i} and since.
+
+    seed 3.2.2: a slave sends its request when the bus is idle; spec: only once its backoff ran out
+    (colliders) or in its own idle slot of the window after a collision (all)."""
+    if variant not in VARIANTS:
+        raise ValueError(variant)
+    if variant == "seed":
+        return f"ph{i} == {PENDING}"
+    if p.scope == "colliders":
+        return f"ph{i} == {PENDING} and bo{i} == 0"
+    return f"ph{i} == {PENDING} and (since == {window_slots(p, n)} or since == {rank * p.backoff_slots})"
 
 
 def build(p: ArbParams, variant: str, slaves: int | None = None) -> Model:
-    if variant not in ("seed", "spec"):
+    if variant not in VARIANTS:
         raise ValueError(variant)
     sl = p.slaves[:slaves] if slaves else p.slaves
     n = len(sl)
     spec = variant == "spec" and p.scope == "colliders"
     window = variant == "spec" and p.scope == "all"
     track = variant == "spec"
-    W = n * p.backoff_slots
+    W = window_slots(p, n)
     targets = sorted({s.target for s in sl})
     tcode = {t: i for i, t in enumerate(targets)}
     maxrem = max(max(s.fetch_slots, s.deliver_slots) for s in sl)
@@ -45,7 +90,7 @@ def build(p: ArbParams, variant: str, slaves: int | None = None) -> Model:
     for i, s in enumerate(sl):
         vs.append(Var(f"ph{i}", 2, doc=f"{s.short}: 0 idle, 1 record pending, 2 being served"))
         if spec:
-            vs.append(Var(f"bo{i}", (s.rank + 1) * p.backoff_slots, doc=f"{s.short}: backoff slots left"))
+            vs.append(Var(f"bo{i}", collision_backoff(p, s.rank), doc=f"{s.short}: backoff slots left"))
         if track:
             vs.append(Var(f"col{i}", p.max_collisions + 1, doc=f"{s.short}: collisions of this request"))
     if window:
@@ -55,12 +100,7 @@ def build(p: ArbParams, variant: str, slaves: int | None = None) -> Model:
            Var("mdst", max(len(targets) - 1, 1)), Var("err", 1, doc="monitor: record lost or duplicated")]
 
     def sends(i: int) -> str:
-        # seed 3.2.2: a slave sends XMIT_REQ when the bus is idle; spec: only once its backoff ran out
-        if spec:
-            return f"ph{i} == {PENDING} and bo{i} == 0"
-        if window:
-            return f"ph{i} == {PENDING} and (since == {W} or since == {sl[i].rank * p.backoff_slots})"
-        return f"ph{i} == {PENDING}"
+        return send_guard(p, variant, i, sl[i].rank, n)
 
     defs = [("nsend", count_of(sends(i) for i in range(n)))]
     nsend = "nsend"
@@ -91,7 +131,7 @@ def build(p: ArbParams, variant: str, slaves: int | None = None) -> Model:
             coll.append((f"col{i}", f"min(col{i} + 1, {p.max_collisions + 1}) if ({sends(i)}) else col{i}"))
         if spec:
             # spec arbitration.address_backoff: after a corrupt echo wait (rank + 1) backoff slots
-            coll.append((f"bo{i}", f"{(s.rank + 1) * p.backoff_slots} if ({sends(i)}) else max(bo{i} - 1, 0)"))
+            coll.append((f"bo{i}", f"{collision_backoff(p, s.rank)} if ({sends(i)}) else max(bo{i} - 1, 0)"))
     if window:
         coll.append(("since", "0"))     # every slave heard the corrupt frame: a new window starts
     rules.append(Rule("collision", f"mph == {M_IDLE} and {nsend} >= 2", tuple(coll), actor="bus", ticks=1,
@@ -130,4 +170,5 @@ def build(p: ArbParams, variant: str, slaves: int | None = None) -> Model:
     label = f"{variant}/{p.scope}" if variant == "spec" else variant
     return Model(name=f"arbitration[{p.bus},{label},{n} slaves]", vars=vs, rules=rules, invariants=invs,
                  responses=resp, defs=defs, tick_us=p.slot_us, participants=[m] + [s.short for s in sl],
-                 notes=[f"seed {p.rule_section}; slot = {p.request} + frame gap = {p.slot_us:.0f} us"])
+                 notes=[f"seed {p.rule_section}; slot = {p.request} + frame gap = {p.slot_us:.0f} us"],
+                 origin={"model": "arbitration", "bus": p.bus, "variant": variant})

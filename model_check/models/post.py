@@ -14,6 +14,19 @@ recomputes the verdict from the node conditions and the hierarchy.
 Children that share role, status and subtree shape (the legs, the joints of a
 leg) are identified in any order and declared symmetric, so the full network
 is decided with symmetry reduction.
+
+Abstracted away, and checked on bus traces by tracecheck instead:
+- the broadcast INIT after a POST that did not halt (seed 3.2.3): it follows
+  the verdict and changes no NODES entry; the validator checks one INIT per
+  passed POST and none after a HALTED one;
+- corruption of ID_REQ / ID_ACK frames and late answers: one identification
+  step stands for the whole exchange, whose outcomes the id_retry model
+  proves (a corrupt frame fails its CRC and counts as lost there); the
+  validator checks each exchange's timeout and retries on the wire;
+- the sub-masters' relays (SPU, MMC, LCP: POST_QUERY / POST_REPORT): a
+  sub-master's report is its own POST over its bus, i.e. the sub-tree here;
+  the validator recomputes the verdict from every bus's own ID exchanges
+  (`expected_verdict`), so a sub-master reporting wrongly is caught too.
 """
 from __future__ import annotations
 
@@ -150,38 +163,45 @@ def build(p: PostParams, legs: int | None = None, symmetry: bool = True) -> Mode
     return model
 
 
+def expected_verdict(p: PostParams, t: Tree, answered: dict[str, bool], mcp_ok: bool = True) -> tuple[str, set[str]]:
+    """seed 6.3, by the spec's rule: the verdict and the required nodes it must name, from which nodes
+    answered their identification (`answered`, short -> bool, every node of the tree) and the hierarchy.
+
+    The independent oracle of this model, and the rule the trace validator holds the MCP's verdict to."""
+    def present(s: str) -> bool:
+        n = t.by[s]
+        up = mcp_ok if n.master == p.root else present(n.master)
+        return up and answered[s]
+
+    absent = [s for s in answered if not present(s)]
+    if not mcp_ok:
+        return "HALTED", {p.root}
+    named = {s for s in absent if t.by[s].required}
+    expect = "OPERATIONAL"
+    for name, key, least, roles in p.quorums:
+        groups: dict[int, list[str]] = {}
+        for s in answered:
+            if p.roles[s] in roles and getattr(t.by[s], key) is not None:
+                groups.setdefault(getattr(t.by[s], key), []).append(s)
+        whole = sum(all(present(s) for s in g) for g in groups.values())
+        outside = named - {s for g in groups.values() for s in g}
+        if whole < least or outside:
+            expect = "HALTED"
+        elif whole < len(groups) and expect != "HALTED":
+            expect = "DEGRADED"
+        if not (whole < least):
+            named -= {s for g in groups.values() for s in g}   # a tolerated missing leg is no reason to halt
+    if expect != "HALTED" and any(not t.by[s].required for s in absent):
+        expect = "DEGRADED"
+    if not p.quorums and named:
+        expect = "HALTED"
+    return expect, named
+
+
 def oracle_mismatch(p: PostParams, t: Tree, names: dict[str, str], values: dict[str, int]) -> str | None:
     """Independent oracle: verdict and missing required nodes straight from conditions and the hierarchy."""
     cond = {names[k]: v for k, v in values.items() if k in names}
-
-    def present(s: str) -> bool:
-        n = t.by[s]
-        up = values["mcp"] == 1 if n.master == p.root else present(n.master)
-        return up and cond[s] == OK
-
-    absent = [s for s in cond if not present(s)]
-    if values["mcp"] == 2:
-        expect, named = "HALTED", {p.root}
-    else:
-        named = {s for s in absent if t.by[s].required}
-        expect = "OPERATIONAL"
-        for name, key, least, roles in p.quorums:
-            groups: dict[int, list[str]] = {}
-            for s in cond:
-                if p.roles[s] in roles and getattr(t.by[s], key) is not None:
-                    groups.setdefault(getattr(t.by[s], key), []).append(s)
-            whole = sum(all(present(s) for s in g) for g in groups.values())
-            outside = named - {s for g in groups.values() for s in g}
-            if whole < least or outside:
-                expect = "HALTED"
-            elif whole < len(groups) and expect != "HALTED":
-                expect = "DEGRADED"
-            if not (whole < least):
-                named -= {s for g in groups.values() for s in g}   # a tolerated missing leg is no reason to halt
-        if expect != "HALTED" and any(not t.by[s].required for s in absent):
-            expect = "DEGRADED"
-        if not p.quorums and named:
-            expect = "HALTED"
+    expect, named = expected_verdict(p, t, {s: c == OK for s, c in cond.items()}, values["mcp"] != 2)
     got = {v: k for k, v in VERDICT.items()}[values["vd"]]
     reported = {p.root} if values["mcp"] == 2 else {s for s in cond if t.by[s].required and cond[s] != OK}
     if expect == "HALTED" and got == "HALTED":
@@ -189,5 +209,6 @@ def oracle_mismatch(p: PostParams, t: Tree, names: dict[str, str], values: dict[
             return f"HALTED report {sorted(reported)} does not name {sorted(named - reported)}"
         return None
     if got != expect:
-        return f"verdict {got}, oracle says {expect} (missing: {sorted(absent)})"
+        absent = sorted(s for s in cond if cond[s] != OK)
+        return f"verdict {got}, oracle says {expect} (missing: {absent})"
     return None

@@ -34,8 +34,11 @@ class TraceRow(NamedTuple):
 
 
 def read_trace(path: Path) -> list[TraceRow]:
+    """The frames of trace.tsv (its debug-port rows, bus `debug`, are no frames on a wire)."""
+    from tracecheck.trace import DEBUG_BUS
+
     with open(path, newline="") as fh:
-        rows = list(csv.DictReader(fh, delimiter="\t"))
+        rows = [r for r in csv.DictReader(fh, delimiter="\t") if r["bus"] != DEBUG_BUS]
     return [TraceRow(float(r["start_s"]), float(r["end_s"]), r["bus"], r["sender"], r["src"], r["dst"], r["message"],
                      bytes.fromhex(r["bytes"]), tuple(f for f in r["flags"].split(",") if f)) for r in rows]
 

@@ -117,7 +117,7 @@ def test_tpsc_initiates_and_resends_after_a_corrupt_echo(host_factory, spec):
 def test_high_obstacle_with_the_tpsc_in_simavr_behaves_like_the_python_run(firmware_built, spec):
     from sim2d.runner import run_sil
     from sim2d import runner
-    from sim2d.sim import trace_lines
+    from tracecheck.trace import trace_lines
     path = str(REPO / "scenarios" / "high_obstacle.yaml")
     python = runner.run(path, spec=spec)
     sil = run_sil(path, ("TPSC",), spec=spec)

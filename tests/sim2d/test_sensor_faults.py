@@ -21,7 +21,7 @@ ROOM = "duration: 5\narena: {size: [6, 4], ambient_lux: 10, ambient_temp: 20}\nr
     ("  - {at: 1, kill: IRRC, noise: 0.1}\n", 5, "noise belongs to a sensor fault"),
     ("  - {at: 1, sensor: TPSC, noise: 0.1}\n", 5, "'TPSC' is not one of"),
     ("  - {at: 1, sensor: IRRC, noise: -1}\n", 5, "noise: must be >= 0"),
-    ("  - {at: 1, sensor: IRRC, kill: USRC, noise: 0.1}\n", 5, "exactly one of kill, mute, bus or sensor"),
+    ("  - {at: 1, sensor: IRRC, kill: USRC, noise: 0.1}\n", 5, "exactly one of kill, mute, bus, sensor, request, collide"),
     ("  - {at: 4, until: 2, sensor: USRC, noise: 0.1}\n", 5, "until must be after at"),
 ])
 def test_bad_sensor_faults_are_one_line_errors(write, spec, faults, line, fragment):

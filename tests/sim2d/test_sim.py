@@ -9,7 +9,8 @@ from arachnae_proto.skeletons import skeleton_class
 
 from sim2d.runner import run as run_file
 from sim2d.scenario import load_scenario
-from sim2d.sim import Simulation, trace_lines
+from sim2d.sim import Simulation
+from tracecheck.trace import trace_lines
 
 ROOT = Path(__file__).resolve().parents[2]
 

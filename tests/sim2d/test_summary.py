@@ -29,3 +29,13 @@ def test_battery_columns_show_the_sag_and_the_psc_alarms() -> None:
     assert cells[9:11] == ["4.18/4.66/4.70", "4.22/4.43, 1"]
     m["battery"].update(psc_mean_min_v=None, psc_level_min_v=None, psc_alarms=None)   # no PSC (optional node)
     assert markdown([m]).splitlines()[2].split(" | ")[10] == "-"
+
+
+def test_protocol_column_shows_violations_and_the_wait_against_k() -> None:
+    """Issue 11: a run whose trace broke the verified protocol shows it in the table, with each contended
+    bus's longest wait against the checker's K."""
+    m = _metrics("a", 1, [True])
+    assert markdown([m]).splitlines()[2].split(" | ")[-1] == "- |"
+    m["protocol"] = {"violations": 2, "max_wait_slots": {"first": 39.02, "sensor": 4.0},
+                     "k_slots": {"first": 36, "sensor": 32}}
+    assert markdown([m]).splitlines()[2].split(" | ")[-1] == "2; first 39.0/36 sensor 4.0/32 |"

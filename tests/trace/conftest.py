@@ -1,0 +1,36 @@
+"""Shared runs for the trace tests: a short POST scenario with missing nodes, and the checker's replay."""
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+# PSC (optional, sensor bus) and LCP(1) with its leg's JACs are not fitted: POST is DEGRADED, and the
+# masters' ID_REQ retries and timeouts to the missing nodes are on the wire
+MISSING = """name: missing
+duration: 3
+arena: {size: [4, 3]}
+robot: {pose: [2, 1.5, 0], task: idle, absent: [PSC, "LCP(1)"]}
+expect: {post: DEGRADED}
+"""
+
+
+@pytest.fixture(scope="session")
+def missing_scenario(tmp_path_factory) -> Path:
+    p = tmp_path_factory.mktemp("scen") / "missing.yaml"
+    p.write_text(MISSING)
+    return p
+
+
+@pytest.fixture(scope="session")
+def replay_dir(tmp_path_factory) -> Path:
+    """`arachnae check arbitration --variant seed --bus sensor --size 2 --replay DIR`: the collide-forever lasso."""
+    out = tmp_path_factory.mktemp("replay")
+    p = subprocess.run([sys.executable, "-m", "arachnae", "check", "arbitration", "--variant", "seed", "--bus",
+                        "sensor", "--size", "2", "--quiet", "--replay", str(out)], capture_output=True, text=True,
+                       timeout=300)
+    assert p.returncode == 1, p.stderr            # the seed variant violates served_USRC
+    assert "replay:" in p.stdout
+    return out

@@ -1,0 +1,71 @@
+"""A mutation of the node code alone (never the spec or the models) makes the trace validator fail, naming
+the first offending frame by time and bus (issue 11, part 1): the proofs reach the code that runs."""
+from __future__ import annotations
+
+import re
+from dataclasses import replace
+
+from behaviours import mcp
+from behaviours.runtime import BusTiming, Runtime
+from sim2d import runner
+
+FIRST = re.compile(r"^(\d+\.\d{6}) s bus (\w+) \(trace line (\d+)\): (\w+): ")
+
+
+def first(outcome) -> tuple[float, str, str]:
+    p = outcome.result.metrics["protocol"]
+    assert p["violations"] > 0, p
+    m = FIRST.match(p["first"])
+    assert m, p["first"]
+    return float(m.group(1)), m.group(2), m.group(4)
+
+
+def mutate_timing(monkeypatch, **changes) -> None:
+    init = BusTiming.__init__
+
+    def mutated(self, bus):
+        init(self, bus)
+        for k, v in changes.items():
+            setattr(self, k, v)
+    monkeypatch.setattr(BusTiming, "__init__", mutated)
+
+
+def test_unmutated_code_has_no_violation(missing_scenario):
+    out = runner.run(str(missing_scenario))
+    p = out.result.metrics["protocol"]
+    assert p["violations"] == 0, p["first"]
+    assert p["checked"]["id_req"] > 0 and p["checked"]["post_verdict"] == 1
+    assert not out.failed
+
+
+def test_backoff_rank_mutation_is_caught(monkeypatch, replay_dir):
+    rank = Runtime.rank
+    monkeypatch.setattr(Runtime, "rank", lambda self, bus: len(self.net.requesters[bus]) - 1 - rank(self, bus))
+    t, bus, rule = first(runner.run(str(replay_dir / "replay_arbitration_sensor_spec.yaml")))
+    assert (bus, rule) == ("sensor", "backoff_slot") and t > 3.0
+
+
+def test_retry_count_mutation_is_caught(monkeypatch, missing_scenario):
+    mutate_timing(monkeypatch, id_retries=0)
+    t, bus, rule = first(runner.run(str(missing_scenario)))
+    assert rule == "id_retry" and bus in ("sensor", "leg") and t < 2.0
+
+
+def test_timeout_mutation_is_caught(monkeypatch, missing_scenario):
+    mutate_timing(monkeypatch, timeout_s=0.004)
+    t, bus, rule = first(runner.run(str(missing_scenario)))
+    assert rule == "id_timeout" and t < 1.0
+
+
+def test_post_quorum_mutation_is_caught(monkeypatch, missing_scenario):
+    verdict = mcp.verdict
+
+    def six_legs(net, missing):
+        return verdict(replace(net, quorums=tuple(replace(q, min_complete=q.min_complete + 1)
+                                                   for q in net.quorums)), missing)
+    monkeypatch.setattr(mcp, "verdict", six_legs)
+    out = runner.run(str(missing_scenario))
+    t, bus, rule = first(out)
+    assert (bus, rule) == ("debug", "post_verdict")
+    assert "says HALTED" in out.result.metrics["protocol"]["first"] and "says DEGRADED" in \
+        out.result.metrics["protocol"]["first"]

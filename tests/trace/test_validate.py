@@ -1,0 +1,137 @@
+"""`arachnae trace check` on a saved trace: clean runs pass, a tampered trace names the offending frame,
+a bad trace file is a one-line file:line error."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from sim2d import runner
+
+
+def cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "arachnae", *args], capture_output=True, text=True, timeout=300)
+
+
+@pytest.fixture(scope="module")
+def saved(missing_scenario, tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("run") / "o"
+    runner.write_outputs(runner.run(str(missing_scenario)), out)
+    return out
+
+
+def rows(path: Path) -> list[list[str]]:
+    return [line.split("\t") for line in path.read_text().splitlines()]
+
+
+def write(path: Path, table: list[list[str]]) -> Path:
+    path.write_text("\n".join("\t".join(r) for r in table) + "\n")
+    return path
+
+
+def test_saved_run_checks_clean_and_reports_protocol_metrics(saved):
+    m = json.loads((saved / "metrics.json").read_text())
+    assert m["protocol"]["violations"] == 0 and m["protocol"]["k_slots"]["sensor"] > 0
+    assert {"name": "protocol.violations eq", "passed": True, "detail": "protocol.violations = 0, eq 0"} \
+        in m["expectations"]
+    p = cli("trace", "check", str(saved / "trace.tsv"))
+    assert p.returncode == 0, p.stdout + p.stderr
+    assert "0 protocol violation(s)" in p.stdout
+
+
+def test_overlapping_frames_are_two_talkers(saved, tmp_path):
+    table = rows(saved / "trace.tsv")
+    i = next(i for i, r in enumerate(table[1:], 1) if r[2] == "leg" and r[3] == "LCP(2)")
+    prev = next(r for r in reversed(table[1:i]) if r[2] == "leg")
+    table[i][0] = f"{float(prev[1]) - 0.001:.6f}"          # LCP(2)'s reply starts before the MMC's frame ended
+    p = cli("trace", "check", str(write(tmp_path / "t.tsv", table)))
+    assert p.returncode == 1
+    lines = p.stdout.splitlines()
+    assert lines[0].startswith(f"{float(prev[1]) - 0.001:.6f} s bus leg (trace line {i + 1}): one_talker: two talkers")
+    assert "1 protocol violation(s)" in lines[-1]
+
+
+def test_a_missing_retry_is_named(saved, tmp_path):
+    table = rows(saved / "trace.tsv")
+    reqs = [i for i, r in enumerate(table) if r[2] == "sensor" and r[6] == "ID_REQ" and r[5] == "PSC"]
+    assert len(reqs) == 2                                  # seed 3.2.2: one retry to the absent PSC
+    del table[reqs[1]]
+    p = cli("trace", "check", str(write(tmp_path / "t.tsv", table)), "--json")
+    out = json.loads(p.stdout)
+    assert p.returncode == 1 and out["by_rule"] == {"id_retry": 1} or "id_retry" in out["by_rule"]
+    assert "bus sensor" in out["first"] and "no reply to ID_REQ 1 of 2 to PSC" in out["first"]
+
+
+def test_bad_trace_files_are_one_line_errors(saved, tmp_path):
+    bad = tmp_path / "bad.tsv"
+    bad.write_text("time\tbus\n")
+    p = cli("trace", "check", str(bad))
+    assert p.returncode == 1 and p.stderr == f"{bad}:1: not a bus trace: header must start with " \
+        "start_s end_s bus sender src dst message bytes flags\n"
+    table = rows(saved / "trace.tsv")
+    table[5][7] = "zz"
+    p = cli("trace", "check", str(write(tmp_path / "hex.tsv", table)))
+    assert p.returncode == 1 and p.stderr == f"{tmp_path / 'hex.tsv'}:6: bytes column is not hexadecimal\n"
+    table = rows(saved / "trace.tsv")
+    table[3][2] = "nobus"
+    p = cli("trace", "check", str(write(tmp_path / "bus.tsv", table)))
+    assert p.returncode == 1 and p.stderr.startswith(f"{tmp_path / 'bus.tsv'}:4: unknown bus 'nobus'")
+    p = cli("trace", "check", str(tmp_path / "none.tsv"))
+    assert p.returncode == 1 and p.stderr.count("\n") == 1 and "cannot read trace" in p.stderr
+    p = cli("trace", "check", str(saved / "trace.tsv"), "--arbitration", "sensor=maybe")
+    assert p.returncode == 1 and p.stderr.startswith("--arbitration: expected BUS=seed|spec")
+
+
+def test_new_fault_kinds_are_checked(tmp_path):
+    from arachnae.errors import UserError
+    from sim2d.scenario import load_scenario
+
+    base = "duration: 3\narena: {size: [4, 3]}\nrobot: {pose: [1, 1, 0]}\n"
+    for fault, msg in (("{at: 1, request: TPSC, until: 2}", "no until"),
+                       ("{at: 1, collide: [TPSC, MMC]}", "is not one of"),
+                       ("{at: 1, collide: [TPSC, SPU]}", "share one bus"),
+                       ("{at: 1, request: MMC}", "is not one of")):
+        p = tmp_path / "s.yaml"
+        p.write_text(base + f"faults:\n  - {fault}\n")
+        with pytest.raises(UserError, match=msg) as err:
+            load_scenario(p, runner.load_spec_once())
+        assert str(err.value).startswith(f"{p}:5: ")
+    p.write_text(base + "arbitration: {leg: seed}\n")
+    with pytest.raises(UserError, match="unknown key 'leg'"):
+        load_scenario(p, runner.load_spec_once())
+
+
+def test_a_runs_pcapng_checks_like_its_trace(saved, tmp_path):
+    """A capture (here the run's own bus.pcapng, exact clock) is validated like trace.tsv: same verdict, same
+    figures; a pcapng of a bus the spec does not have is a one-line error naming the file."""
+    from captures.pcapng import read_file, write_file
+
+    p = cli("trace", "check", str(saved / "bus.pcapng"), "--json")
+    t = cli("trace", "check", str(saved / "trace.tsv"), "--json")
+    assert p.returncode == t.returncode == 0, p.stdout + p.stderr
+    cap, tsv = json.loads(p.stdout), json.loads(t.stdout)
+    assert {k: cap[k] for k in ("violations", "requests", "served", "max_wait_slots")} == \
+        {k: tsv[k] for k in ("violations", "requests", "served", "max_wait_slots")}
+    assert cap["checked"]["id_req"] == tsv["checked"]["id_req"] > 0
+    capture = read_file(saved / "bus.pcapng")
+    frames = [f._replace(bus="nobus") if f.bus == "leg" else f for f in capture.frames]
+    interfaces = tuple(i._replace(name="nobus") if i.name == "leg" else i for i in capture.interfaces)
+    write_file(tmp_path / "bad.pcapng", interfaces, frames)
+    p = cli("trace", "check", str(tmp_path / "bad.pcapng"))
+    assert p.returncode == 1 and p.stderr.count("\n") == 1
+    assert p.stderr.startswith(f"{tmp_path / 'bad.pcapng'}: frame ") and "'nobus' is not a bus of the spec" in p.stderr
+
+
+def test_untimed_check_still_names_a_missing_retry(saved, tmp_path):
+    """--untimed (a capture without a true clock) keeps the rules that need none: a dropped ID_REQ retry."""
+    table = rows(saved / "trace.tsv")
+    reqs = [i for i, r in enumerate(table) if r[2] == "sensor" and r[6] == "ID_REQ" and r[5] == "PSC"]
+    del table[reqs[1]]
+    p = cli("trace", "check", str(write(tmp_path / "t.tsv", table)), "--untimed", "--json")
+    out = json.loads(p.stdout)
+    assert p.returncode == 1 and "id_retry" in out["by_rule"] and "bound_K" not in out["by_rule"]
+    assert "no reply to ID_REQ 1 of 2 to PSC" in out["first"]
+    assert "request_slot" not in out["checked"] and "one_talker" not in out["checked"]
