@@ -39,6 +39,9 @@ class Result:
     layer_starts: list[int] = field(default_factory=list)   # first id of each breadth-first layer
     times: dict[str, float] = field(default_factory=dict)    # search / bounds / liveness seconds
     peak_bytes: int = 0                        # resident memory the check added at its peak
+    store_bytes: int = 0                       # bytes of the stored graph (states, parents, edges)
+    cpu: float = 0.0                           # CPU seconds of the whole check (search and properties)
+    proof: bool = True                         # False after a bitstate search: a pass proves nothing
 
     @property
     def ok(self) -> bool:
@@ -54,7 +57,13 @@ class Result:
 
     @property
     def bytes_per_state(self) -> float:
+        """Resident peak per state: the figure that matters on big models (fixed overheads
+        dominate it on tiny ones, where `store_bytes_per_state` is the per-state cost)."""
         return self.peak_bytes / max(self.states, 1)
+
+    @property
+    def store_bytes_per_state(self) -> float:
+        return self.store_bytes / max(self.states, 1)
 
     @property
     def layers(self) -> list[list[int]]:
@@ -104,7 +113,7 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
                             "reduced graph are not a proof")
     meter = Meter()
     bar = Progress(model.name) if progress else None
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     store = StateStore(comp.layout.total_bits, len(model.rules))
     store.add_initial(comp.init)
     frontier, lo = [comp.init], 0
@@ -126,6 +135,7 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
             res.layer_starts.append(lo + len(frontier))
         if bar:
             bar.update(len(res.layer_starts) - 2, len(store), len(frontier))
+    res.store_bytes = store.nbytes         # before finish drops the hash table: the search's peak
     store.finish()
     res.store = store
     res.seconds = time.perf_counter() - t0
@@ -147,6 +157,7 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
         return res
     finally:
         res.peak_bytes = meter.peak()
+        res.cpu = time.process_time() - c0
 
 
 def _final_checks(res: Result) -> None:

@@ -26,7 +26,7 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
-from model_check.storage import ranges
+from model_check.storage import pieces, ranges
 from model_check.trace import Violation, concretise, follow
 
 if TYPE_CHECKING:
@@ -84,10 +84,13 @@ def check_response(res: Result, index: int, graph: _Graph | None = None) -> tupl
     in_b[roots] = True
     fr = roots
     while fr.size:
-        v = dst[ranges(off, fr)]
-        v = np.unique(v[~goal[v] & ~in_b[v]])
-        in_b[v] = True
-        fr = v.astype(np.int64)
+        found = []
+        for part in pieces(off, fr):
+            v = dst[ranges(off, part)]
+            v = v[~goal[v] & ~in_b[v]]
+            in_b[v] = True
+            found.append(v)
+        fr = np.unique(np.concatenate(found)).astype(np.int64)
     b = np.flatnonzero(in_b)
     deg = off[b + 1] - off[b]
     sub = _SubGraph(store, goal, b)
@@ -95,17 +98,16 @@ def check_response(res: Result, index: int, graph: _Graph | None = None) -> tupl
     if terminal.size:
         _tick(res, "liveness", t)
         return None, _lasso(res, resp.name, roots, sub, [int(terminal[0])], [], graph, True)
-    # per state of B: edges staying in B, and the most ticks of an edge leaving it (into goal);
-    # edges into goal are few, so they are found once and subtracted (no per-edge int arrays)
-    leave = np.flatnonzero(goal[dst])
-    leave = leave[in_b[np.searchsorted(off, leave, side="right") - 1]]
-    src = np.searchsorted(off, leave, side="right") - 1
+    # per state of B: edges staying in B, and the most ticks of an edge leaving it (into goal),
+    # a slice of B at a time so that no array has one entry per edge
     outdeg = np.zeros(len(store), np.int32)
-    outdeg[b] = deg
-    np.subtract.at(outdeg, src, 1)
     longest = np.zeros(len(store), np.int32)
-    np.maximum.at(longest, src, graph.ticks[rule[leave]])
-    del leave, src
+    for part in pieces(off, b):
+        e = ranges(off, part)
+        into = goal[dst[e]]
+        src = np.repeat(part, off[part + 1] - off[part])
+        outdeg[part] = np.bincount(src[~into] - part[0], minlength=int(part[-1] - part[0] + 1))[part - part[0]]
+        np.maximum.at(longest, src[into], graph.ticks[rule[e[into]]])
     t = _tick(res, "liveness", t)
     # peel B from its sinks: longest tick path where acyclic; what is left reaches a cycle
     ready = b[outdeg[b] == 0]
@@ -113,14 +115,18 @@ def check_response(res: Result, index: int, graph: _Graph | None = None) -> tupl
     rev_deg = np.diff(graph.rev_ptr)
     while ready.size:
         peeled += ready.size
-        e = ranges(graph.rev_ptr, ready)
-        via = np.repeat(longest[ready], rev_deg[ready])
-        u = graph.rev_src[e]
-        keep = in_b[u]
-        u = u[keep]
-        np.maximum.at(longest, u, graph.ticks[graph.rev_rule[e[keep]]] + via[keep])
-        uu, cnt = np.unique(u, return_counts=True)
-        outdeg[uu] -= cnt
+        touched = []
+        for part in pieces(graph.rev_ptr, ready):
+            e = ranges(graph.rev_ptr, part)
+            via = np.repeat(longest[part], rev_deg[part])
+            u = graph.rev_src[e]
+            keep = in_b[u]
+            u = u[keep]
+            np.maximum.at(longest, u, graph.ticks[graph.rev_rule[e[keep]]] + via[keep])
+            uu, cnt = np.unique(u, return_counts=True)
+            outdeg[uu] -= cnt
+            touched.append(uu)
+        uu = np.unique(np.concatenate(touched))
         ready = uu[outdeg[uu] == 0]
     if peeled == len(b):
         _tick(res, "bounds", t)

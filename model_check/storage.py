@@ -32,6 +32,7 @@ import numpy as np
 from model_check import expr
 
 LOAD = 0.7                          # grow the hash table beyond this fill
+REHASH = 1 << 18                    # states re-inserted per vectorised step when the table grows
 _M1 = np.uint64(0x9E3779B97F4A7C15)  # Fibonacci hashing multiplier
 _M2 = np.uint64(0xBF58476D1CE4E5B9)  # splitmix64 constants, to mix the words of a key
 _M3 = np.uint64(0x94D049BB133111EB)
@@ -71,11 +72,13 @@ def _status(key: str) -> int:
 
 
 class Grow:
-    """An append-only numpy array with amortised doubling.
+    """An append-only numpy array grown in place by 1/4 at a time.
 
-    Pages past the end are never written and so not resident; growing copies, so the old
-    and the new array are both resident for a moment (`ndarray.resize` would avoid the
-    copy but zero-fills the whole new capacity, which made the peak larger)."""
+    `ndarray.resize` reallocates, which for a large (mmap-backed) block is an mremap: no
+    copy, so the old and the new array are never both resident (a copying doubling put
+    one whole extra array on top of the peak). It zero-fills the new capacity, which is
+    therefore resident at once; growing by a quarter bounds that slack to 25 %.
+    A view taken before an `append` is invalid after it (the block may have moved)."""
 
     def __init__(self, dtype, width: int = 0, capacity: int = 1024):
         self.width = width
@@ -85,16 +88,36 @@ class Grow:
     def append(self, chunk: np.ndarray) -> None:
         need = self.n + len(chunk)
         if need > len(self.data):
-            cap = max(need, 2 * len(self.data))
-            new = np.empty((cap, self.width) if self.width else cap, self.data.dtype)
-            new[:self.n] = self.data[:self.n]
-            self.data = new
+            cap = max(need, len(self.data) + len(self.data) // 4)
+            self.data.resize((cap, self.width) if self.width else cap, refcheck=False)
         self.data[self.n:need] = chunk
         self.n = need
 
     @property
     def view(self) -> np.ndarray:
         return self.data[:self.n]
+
+
+def mix64(rows: np.ndarray, seed: np.uint64 = np.uint64(0)) -> np.ndarray:
+    """A 64-bit hash of each row of uint64 words (Fibonacci multiply, splitmix64 finaliser);
+    a different `seed` gives an independent-looking second hash (bitstate's double hashing)."""
+    h = (rows[:, 0] ^ seed) * _M1
+    for w in range(1, rows.shape[1]):
+        h = (h ^ (h >> np.uint64(31)) ^ rows[:, w]) * _M2
+    return (h ^ (h >> np.uint64(29))) * _M3
+
+
+def pieces(offsets: np.ndarray, ids: np.ndarray, edges: int = 1 << 20):
+    """`ids` cut into consecutive runs of at most about `edges` CSR edges each, so a
+    vectorised step over their edges needs bounded temporary memory (issue 12)."""
+    if ids.size == 0:
+        return
+    cum = np.cumsum(offsets[ids + 1] - offsets[ids])
+    if cum[-1] <= edges:
+        yield ids
+        return
+    cuts = np.searchsorted(cum, np.arange(edges, int(cum[-1]), edges), side="right")
+    yield from np.split(ids, np.unique(cuts))
 
 
 def ranges(offsets: np.ndarray, ids: np.ndarray) -> np.ndarray:
@@ -149,11 +172,7 @@ class StateStore:
 
     # -- hashing -------------------------------------------------------------------------
     def _hash(self, rows: np.ndarray) -> np.ndarray:
-        h = rows[:, 0] * _M1
-        for w in range(1, self.words):
-            h = (h ^ (h >> np.uint64(31)) ^ rows[:, w]) * _M2
-        h = (h ^ (h >> np.uint64(29))) * _M3
-        return h >> np.uint64(64 - self._bits)
+        return mix64(rows) >> np.uint64(64 - self._bits)
 
     @property
     def _bits(self) -> int:
@@ -165,10 +184,13 @@ class StateStore:
             return
         while need > LOAD * size:
             size *= 2
+        self.table = None                             # the old table goes before the new one comes
         self.table = np.full(size, -1, np.int32)
-        n = len(self)
-        slot = self._hash(self.keys.view).astype(np.int64)
-        self._claim(slot, np.arange(n, dtype=np.int32), lambda pending, ids: None)
+        keys = self.keys.view
+        for lo in range(0, len(self), REHASH):        # in slices: the hash temporaries stay small
+            rows = keys[lo:lo + REHASH]
+            self._claim(self._hash(rows).astype(np.int64), np.arange(lo, lo + len(rows), dtype=np.int32),
+                        lambda pending, ids: None)
 
     def _claim(self, slot: np.ndarray, values: np.ndarray, on_taken: Callable) -> np.ndarray:
         """Write `values` (distinct, >= 0 or marks <= -2) into free slots, probing in rounds.
