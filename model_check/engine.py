@@ -20,6 +20,8 @@ from model_check.liveness import check_responses
 from model_check.storage import Meter, StateStore
 from model_check.trace import Step, Violation, concretise, follow
 
+SLICE = 1 << 15          # frontier states expanded per call of the generated `edges`
+
 __all__ = ["Result", "Step", "Violation", "explore", "trace_to", "concretise", "follow", "depth_of"]
 
 
@@ -121,13 +123,20 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
     hit = None
     edges = comp.edges
     while frontier:
-        nxt: list[int] = []
-        rules: list[int] = []
-        ends: list[int] = []
-        hit = edges(frontier, nxt, rules, ends)
-        new = store.add_layer(lo, nxt, rules, ends)
+        # a wide layer goes in slices: the successor lists and their dedup dicts are the search's
+        # biggest Python objects; slicing changes nothing (the table dedups across slices, and ids,
+        # parents and the next frontier come out in the same first-seen order)
+        new = []
+        for a in range(0, len(frontier), SLICE):
+            nxt: list[int] = []
+            rules: list[int] = []
+            ends: list[int] = []
+            hit = edges(frontier[a:a + SLICE], nxt, rules, ends)
+            new += store.add_layer(lo + a, nxt, rules, ends)
+            if hit is not None:
+                hit_id = lo + a + len(ends)
+                break
         if hit is not None:
-            hit_id = lo + len(ends)
             break
         lo += len(frontier)
         frontier = new

@@ -62,6 +62,12 @@ class _Graph:
         _tick(res, "liveness", t)
 
 
+def _sinks(off: np.ndarray, ids: np.ndarray) -> np.ndarray:
+    """The states among `ids` without a successor, a slice at a time."""
+    out = [part[off[part + 1] == off[part]] for part in np.array_split(ids, max(1, len(ids) >> 20))]
+    return np.concatenate(out) if out else ids[:0]
+
+
 def _tick(res: Result, key: str, since: float) -> float:
     now = time.perf_counter()
     res.times[key] = res.times.get(key, 0.0) + now - since
@@ -75,7 +81,7 @@ def check_response(res: Result, index: int, graph: _Graph | None = None) -> tupl
     off, dst, rule = store.offsets, store.dst.view, store.rule.view
     t = time.perf_counter()
     goal = store.mask(comp.layout, model.defs, resp.goal)
-    roots = np.flatnonzero(store.mask(comp.layout, model.defs, resp.trigger) & ~goal)
+    roots = np.flatnonzero(store.mask(comp.layout, model.defs, resp.trigger) & ~goal).astype(np.int32)
     if not roots.size:
         _tick(res, "liveness", t)
         return 0, None
@@ -90,11 +96,10 @@ def check_response(res: Result, index: int, graph: _Graph | None = None) -> tupl
             v = v[~goal[v] & ~in_b[v]]
             in_b[v] = True
             found.append(v)
-        fr = np.unique(np.concatenate(found)).astype(np.int64)
-    b = np.flatnonzero(in_b)
-    deg = off[b + 1] - off[b]
+        fr = np.unique(np.concatenate(found)).astype(np.int32)
+    b = np.flatnonzero(in_b).astype(np.int32)       # int32 ids: these arrays can span every state
     sub = _SubGraph(store, goal, b)
-    terminal = b[deg == 0]            # the run ends (a final state) without reaching the goal
+    terminal = _sinks(off, b)        # the run ends (a final state) without reaching the goal
     if terminal.size:
         _tick(res, "liveness", t)
         return None, _lasso(res, resp.name, roots, sub, [int(terminal[0])], [], graph, True)
@@ -112,13 +117,12 @@ def check_response(res: Result, index: int, graph: _Graph | None = None) -> tupl
     # peel B from its sinks: longest tick path where acyclic; what is left reaches a cycle
     ready = b[outdeg[b] == 0]
     peeled = 0
-    rev_deg = np.diff(graph.rev_ptr)
     while ready.size:
         peeled += ready.size
         touched = []
         for part in pieces(graph.rev_ptr, ready):
             e = ranges(graph.rev_ptr, part)
-            via = np.repeat(longest[part], rev_deg[part])
+            via = np.repeat(longest[part], graph.rev_ptr[part + 1] - graph.rev_ptr[part])
             u = graph.rev_src[e]
             keep = in_b[u]
             u = u[keep]
