@@ -115,6 +115,8 @@ def text(res: Result) -> str:
         lines.append("  BOUND EXCEEDED")
     elif not res.proof:
         lines.append("  NO VIOLATION FOUND (bitstate search: NOT a proof, see the estimate above)")
+    elif m.responses and not res.bounds:
+        lines.append("  SAFETY PROPERTIES HOLD (responses not checked)")
     else:
         lines.append("  ALL PROPERTIES HOLD")
     return "\n".join(lines)
@@ -131,6 +133,9 @@ def run_check(args) -> int:
         if getattr(args, "bitstate", None):
             from model_check.bitstate import explore_bitstate
             res, _ = explore_bitstate(model, args.bitstate, progress=not args.quiet)
+        elif getattr(args, "workers", 1) > 1:
+            from model_check.parallel import explore_parallel
+            res = explore_parallel(model, args.workers, progress=not args.quiet)
         else:
             res = explore(model, progress=not args.quiet)
         ok &= res.ok and meets_deadline(res)

@@ -25,6 +25,9 @@ def register(sub) -> None:
     c.add_argument("--spec", default=None, help="spec directory (default: the repository's spec/)")
     c.add_argument("--json", action="store_true", help="print the results as JSON")
     c.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+    c.add_argument("--workers", type=_positive, default=1, metavar="N",
+                   help="search on N processes with a partitioned visited set (safety only: invariants, "
+                        "deadlocks, coverage; the same counts and verdicts as one process)")
     c.add_argument("--bitstate", type=_bits, default=None, metavar="BITS",
                    help="bitstate search in 2^BITS bits of memory (%d..%d), safety only; prints the expected "
                         "omissions: a pass is then NOT a proof" % (BITSTATE_MIN, BITSTATE_MAX))
@@ -126,6 +129,8 @@ def _check(args) -> int:
     _check_options(args, spec)
     if args.promela:
         _check_promela_dir(args.promela)
+    if args.workers > 1 and args.bitstate:
+        raise UserError("--workers and --bitstate: choose one (the bitstate search runs on one process)")
     try:
         return run_check(args)
     except OSError as exc:                  # e.g. the --promela folder filled up or vanished mid-run

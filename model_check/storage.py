@@ -251,7 +251,27 @@ class StateStore:
         number = dict(zip(distinct, range(len(distinct))))
         inv = np.fromiter(map(number.__getitem__, nxt), np.int64, len(nxt))
         del number
-        reps = self.to_words(distinct)
+        ids, new = self._insert_distinct(self.to_words(distinct))
+        # the parent of a new state is the source of the first edge reaching it; successors are
+        # numbered in first-seen order, so a first occurrence is where the running maximum grows
+        top = np.maximum.accumulate(inv)
+        first = np.flatnonzero(np.concatenate(([True], top[1:] > top[:-1])))
+        pos = first[new]
+        self.parent.append((lo + np.searchsorted(ends_a, pos, side="right")).astype(np.int32))
+        self.dst.append(ids[inv].astype(np.int32))
+        return [distinct[i] for i in new.tolist()]
+
+    def add_states(self, states: list[int]) -> list[int]:
+        """As a bare visited set (the parallel search's workers): insert `states` and return the
+        new ones in first-seen order; no parents, no edges."""
+        distinct = list(dict.fromkeys(states))
+        if not distinct:
+            return []
+        _, new = self._insert_distinct(self.to_words(distinct))
+        return [distinct[i] for i in new.tolist()]
+
+    def _insert_distinct(self, reps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """For distinct rows `reps`: the id of each (stored or newly given) and which are new."""
         # probe the table: existing ids, or a mark (-2 - k) claiming a free slot for new key k
         self._grow_table(len(self) + len(reps))
         ids = np.full(len(reps), -1, np.int64)
@@ -274,14 +294,7 @@ class StateStore:
         ids[new] = np.arange(base, base + len(new))
         self.table[slot[new]] = ids[new]                       # type: ignore[index]
         self.keys.append(reps[new])
-        # the parent of a new state is the source of the first edge reaching it; successors are
-        # numbered in first-seen order, so a first occurrence is where the running maximum grows
-        top = np.maximum.accumulate(inv)
-        first = np.flatnonzero(np.concatenate(([True], top[1:] > top[:-1])))
-        pos = first[new]
-        self.parent.append((lo + np.searchsorted(ends_a, pos, side="right")).astype(np.int32))
-        self.dst.append(ids[inv].astype(np.int32))
-        return [distinct[i] for i in new.tolist()]
+        return ids, new
 
     def finish(self, keep_table: bool = False) -> None:
         """The search is over: drop the hash table (unless asked) and the degrees for CSR offsets.
