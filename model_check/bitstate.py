@@ -122,7 +122,7 @@ def explore_bitstate(model: Model, bits: int, compiled: Compiled | None = None, 
         if bar:
             bar.update(depth, states, len(frontier))
     res.seconds = time.perf_counter() - t0
-    res.times["search"] = res.seconds
+    res.times["search"] = time.process_time() - c0
     res.states, res.transitions, res.depth = states, transitions, depth
     res.coverage = cov.tolist()
     if hit is not None:

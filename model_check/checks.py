@@ -57,7 +57,7 @@ def summary(res: Result) -> dict[str, Any]:
     m = res.model
     out: dict[str, Any] = {
         "model": m.name, "holds": res.ok, "proof": res.proof, "states": res.states, "transitions": res.transitions,
-        "depth": res.depth, "seconds": round(res.seconds, 3), "states_per_s": round(res.rate),
+        "depth": res.depth, "seconds": round(res.seconds, 3), "states_per_cpu_s": round(res.rate),
         "bytes_per_state": round(res.bytes_per_state, 1),
         "store_bytes_per_state": round(res.store_bytes_per_state, 1), "cpu_seconds": round(res.cpu, 3),
         "peak_mb": round(res.peak_bytes / 2 ** 20, 1), "times": {k: round(v, 3) for k, v in res.times.items()},
@@ -83,9 +83,9 @@ def text(res: Result) -> str:
     m, s = res.model, summary(res)
     lines = [f"model {m.name}",
              f"  states {res.states:,}  transitions {res.transitions:,}  depth {res.depth}  "
-             f"{res.seconds:.2f} s ({res.rate:,.0f} states/s)  {res.bytes_per_state:.0f} bytes/state "
+             f"{res.seconds:.2f} s wall ({res.rate:,.0f} states per CPU s)  {res.bytes_per_state:.0f} bytes/state "
              f"(peak +{res.peak_bytes / 2 ** 20:.0f} MB; stored graph {res.store_bytes_per_state:.0f} bytes/state)",
-             "  time " + "  ".join(f"{k} {v:.2f} s" for k, v in res.times.items()) + f"  (wall; {res.cpu:.2f} CPU s in all)"]
+             "  CPU time " + "  ".join(f"{k} {v:.2f} s" for k, v in res.times.items()) + f"  ({res.cpu:.2f} s in all)"]
     for note in m.notes:
         lines.append(f"  note: {note}")
     if res.ok and not res.proof:

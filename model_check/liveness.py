@@ -48,7 +48,7 @@ class _Graph:
 
     def __init__(self, res: Result):
         model, store = res.model, res._graph()
-        t = time.perf_counter()
+        t = time.process_time()
         self.actors = [r.actor for r in model.rules]
         groups = sorted({a for a in self.actors if a is not None})
         if len(groups) > 64:       # pragma: no cover - no model comes close
@@ -69,7 +69,7 @@ def _sinks(off: np.ndarray, ids: np.ndarray) -> np.ndarray:
 
 
 def _tick(res: Result, key: str, since: float) -> float:
-    now = time.perf_counter()
+    now = time.process_time()
     res.times[key] = res.times.get(key, 0.0) + now - since
     return now
 
@@ -79,7 +79,7 @@ def check_response(res: Result, index: int, graph: _Graph | None = None) -> tupl
     model, comp, store = res.model, res.compiled, res._graph()
     resp = model.responses[index]
     off, dst, rule = store.offsets, store.dst.view, store.rule.view
-    t = time.perf_counter()
+    t = time.process_time()
     goal = store.mask(comp.layout, model.defs, resp.goal)
     roots = np.flatnonzero(store.mask(comp.layout, model.defs, resp.trigger) & ~goal).astype(np.int32)
     if not roots.size:

@@ -131,10 +131,10 @@ def explore_parallel(model: Model, workers: int = 2, compiled: Compiled | None =
     res.depth = max(layers - 1, 0)
     res.coverage = cov.tolist()
     res.seconds = time.perf_counter() - t0
-    res.times["search"] = res.seconds
     res.peak_bytes = meter.peak() + sum(peak for peak, _ in finals)   # the coordinator and every worker
     res.store_bytes = sum(size for _, size in finals)
     res.cpu = time.process_time() - c0 + _children_cpu() - ch0     # workers: RUSAGE_CHILDREN
+    res.times["search"] = res.cpu
     if hit is not None:
         # the sequential search stops in the same layer and gives the shortest trace
         seq = explore(model, comp, progress=False, check_liveness=False)
