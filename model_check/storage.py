@@ -24,6 +24,8 @@ Python set of ints alone.
 from __future__ import annotations
 
 import ast
+import ctypes
+import ctypes.util
 from itertools import repeat
 from typing import Callable
 
@@ -46,6 +48,7 @@ class Meter:
     the figure falls back to the current RSS at the end (an under-estimate of the peak)."""
 
     def __init__(self) -> None:
+        _trim()
         try:
             with open("/proc/self/clear_refs", "w") as fh:
                 fh.write("5")
@@ -57,6 +60,15 @@ class Meter:
     def peak(self) -> int:
         top = _status("VmHWM") if self.reset else _status("VmRSS")
         return max(0, top - self.base)
+
+
+def _trim() -> None:
+    """Give the C heap's free pages back to the system (glibc malloc_trim), so that arrays of
+    the check cannot hide in memory an earlier step freed and the peak counts them all."""
+    try:
+        ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):       # not glibc: the peak may then under-count
+        pass
 
 
 def _status(key: str) -> int:
@@ -78,7 +90,7 @@ class Grow:
     copy, so the old and the new array are never both resident (a copying doubling put
     one whole extra array on top of the peak). It zero-fills the new capacity, which is
     therefore resident at once; growing by a quarter bounds that slack to 25 %.
-    A view taken before an `append` is invalid after it (the block may have moved)."""
+    A view taken before an `append` or `trim` is invalid after it (the block may have moved)."""
 
     def __init__(self, dtype, width: int = 0, capacity: int = 1024):
         self.width = width
@@ -92,6 +104,10 @@ class Grow:
             self.data.resize((cap, self.width) if self.width else cap, refcheck=False)
         self.data[self.n:need] = chunk
         self.n = need
+
+    def trim(self) -> None:
+        """Capacity down to the length (no more appends are expected; they would still work)."""
+        self.data.resize((max(self.n, 1), self.width) if self.width else max(self.n, 1), refcheck=False)
 
     @property
     def view(self) -> np.ndarray:
@@ -297,12 +313,12 @@ class StateStore:
         return ids, new
 
     def finish(self, keep_table: bool = False) -> None:
-        """The search is over: drop the hash table (unless asked) and the degrees for CSR offsets.
-
-        The arrays are not trimmed: the unused tail of each was never written, so it is not
-        resident, and a trimming copy would double the peak."""
+        """The search is over: drop the hash table (unless asked) and the degrees for CSR offsets,
+        and give back the zero-filled tail of every array (a shrinking realloc: no copy)."""
         if not keep_table:
             self.table = None
+        for g in (self.keys, self.parent, self.dst, self.rule):
+            g.trim()
         deg = self.degree.view
         self.offsets = np.zeros(len(deg) + 1, np.int32 if self.dst.n < 2 ** 31 else np.int64)
         np.cumsum(deg, out=self.offsets[1:])
