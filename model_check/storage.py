@@ -1,8 +1,10 @@
 """Compact storage of the explored state graph (issue 12): numpy arrays, no per-state objects.
 
-A state is the model's packed int (compile.Layout); here it is kept as `words`
-little-endian 64-bit words, one row per state, numbered in breadth-first,
-first-seen order (the state id). Beside the rows:
+A state is the model's packed int (compile.Layout); here it is kept as
+ceil(bits / 8) little-endian bytes, one row per state (17 bytes for id_retry's
+129 bits, not three 64-bit words), numbered in breadth-first, first-seen order
+(the state id); hashing and bit-field reads widen a slice of rows to 64-bit
+words on the fly. Beside the rows:
 
 - an open-addressing hash table of ids (int32, triangular probing, load <= 0.7),
   used while searching and dropped afterwards;
@@ -17,9 +19,9 @@ The generated `edges` function (fastgen) appends every successor of a layer to
 a plain list; `add_layer` deduplicates that list in bulk with numpy (sort within
 the layer, then probe the table in vectorised rounds), which is where the time
 per edge goes from a Python set lookup to a few numpy element operations.
-About 60 bytes per state for a 3-word model (24 for the key, 8 for the table,
-~16 for edges, 4 for the parent, 1-2 for the degree), against roughly 80 for a
-Python set of ints alone.
+About 50 bytes per state for id_retry (17 for the key, 8 for the table while
+searching, ~16 for edges, 4 for the parent, 4 for the CSR offsets), against
+roughly 80 for a Python set of ints alone.
 """
 from __future__ import annotations
 
@@ -151,7 +153,8 @@ class StateStore:
 
     def __init__(self, total_bits: int, rules: int):
         self.words = max(1, -(-total_bits // 64))
-        self.keys = Grow(np.uint64, self.words, 1 << 12)
+        self.width = max(1, -(-total_bits // 8))      # stored bytes per state: no padding to words
+        self.keys = Grow(np.uint8, self.width, 1 << 12)
         self.parent = Grow(np.int32, 0, 1 << 12)
         self.degree = Grow(np.uint16, 0, 1 << 12)
         self.dst = Grow(np.int32, 0, 1 << 14)
@@ -173,7 +176,7 @@ class StateStore:
 
     def state(self, i: int) -> int:
         """The packed state with id `i`."""
-        return int.from_bytes(self.keys.view[i].astype("<u8").tobytes(), "little")
+        return int.from_bytes(self.keys.view[i].tobytes(), "little")
 
     def states(self, ids) -> list[int]:
         return [self.state(int(i)) for i in ids]
@@ -181,10 +184,20 @@ class StateStore:
     def index_of(self, state: int) -> int:
         """Id of a stored state (a linear scan: for traces, not for the search)."""
         row = self.to_words([state])[0]
-        hit = np.flatnonzero((self.keys.view == row).all(axis=1))
+        hit = np.flatnonzero((self.keys.view == self._pack(row[None])[0]).all(axis=1))
         if not hit.size:
             raise KeyError(state)
         return int(hit[0])
+
+    def _pack(self, rows: np.ndarray) -> np.ndarray:
+        """uint64 word rows -> the stored rows of `width` bytes (little-endian, padding dropped)."""
+        return rows.astype("<u8", copy=False).view(np.uint8).reshape(len(rows), 8 * self.words)[:, :self.width]
+
+    def _unpack(self, rows: np.ndarray) -> np.ndarray:
+        """Stored byte rows -> uint64 word rows, for hashing and bit-field arithmetic."""
+        out = np.zeros((len(rows), 8 * self.words), np.uint8)
+        out[:, :self.width] = rows
+        return out.view("<u8").astype(np.uint64, copy=False)
 
     # -- hashing -------------------------------------------------------------------------
     def _hash(self, rows: np.ndarray) -> np.ndarray:
@@ -204,7 +217,7 @@ class StateStore:
         self.table = np.full(size, -1, np.int32)
         keys = self.keys.view
         for lo in range(0, len(self), REHASH):        # in slices: the hash temporaries stay small
-            rows = keys[lo:lo + REHASH]
+            rows = self._unpack(keys[lo:lo + REHASH])
             self._claim(self._hash(rows).astype(np.int64), np.arange(lo, lo + len(rows), dtype=np.int32),
                         lambda pending, ids: None)
 
@@ -245,7 +258,7 @@ class StateStore:
         first = len(self)
         self._grow_table(first + len(rows))
         ids = np.arange(first, first + len(rows), dtype=np.int32)
-        self.keys.append(rows)
+        self.keys.append(self._pack(rows))
         self.parent.append(parents)
         self._claim(self._hash(rows).astype(np.int64), ids, lambda pending, cur: None)
 
@@ -292,14 +305,12 @@ class StateStore:
         self._grow_table(len(self) + len(reps))
         ids = np.full(len(reps), -1, np.int64)
         keys = self.keys.view
+        packed = self._pack(reps)
 
         def seen(pending: np.ndarray, cur: np.ndarray) -> np.ndarray:
             eq = cur >= 0
             old, at = pending[eq], cur[eq]
-            same = keys[at, 0] == reps[old, 0]
-            for w in range(1, self.words):
-                same &= keys[at, w] == reps[old, w]
-            eq[eq] = same
+            eq[eq] = (keys[at] == packed[old]).all(axis=1)
             ids[pending[eq]] = cur[eq]
             return eq
 
@@ -309,7 +320,7 @@ class StateStore:
         base = len(self)
         ids[new] = np.arange(base, base + len(new))
         self.table[slot[new]] = ids[new]                       # type: ignore[index]
-        self.keys.append(reps[new])
+        self.keys.append(packed[new])
         return ids, new
 
     def finish(self, keep_table: bool = False) -> None:
@@ -344,7 +355,7 @@ class StateStore:
     def field(self, shift: int, width: int, lo: int, hi: int) -> np.ndarray:
         """The values of one bit field of states lo .. hi-1, as int64."""
         word, off = divmod(shift, 64)
-        keys = self.keys.view[lo:hi]
+        keys = self._unpack(self.keys.view[lo:hi])
         v = keys[:, word] >> np.uint64(off)
         if off + width > 64:
             v = v | (keys[:, word + 1] << np.uint64(64 - off))
