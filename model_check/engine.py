@@ -160,7 +160,9 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
             res.violation = Violation(kind, prop, concretise(comp, store.states(store.path_to(hit_id))))
             return res
         if model.final_checks:
+            c1 = time.process_time()
             _final_checks(res)
+            res.times["final checks"] = time.process_time() - c1
             if res.violation:
                 return res
         if check_liveness and model.responses:
