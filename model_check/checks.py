@@ -56,9 +56,11 @@ def ms(ticks: int | None, tick_us: float) -> str:
 def summary(res: Result) -> dict[str, Any]:
     m = res.model
     out: dict[str, Any] = {
-        "model": m.name, "holds": res.ok, "states": res.states, "transitions": res.transitions,
-        "depth": res.depth, "seconds": round(res.seconds, 3), "states_per_s": round(res.rate),
-        "bytes_per_state": round(res.bytes_per_state, 1), "times": {k: round(v, 3) for k, v in res.times.items()},
+        "model": m.name, "holds": res.ok, "proof": res.proof, "states": res.states, "transitions": res.transitions,
+        "depth": res.depth, "seconds": round(res.seconds, 3), "states_per_cpu_s": round(res.rate),
+        "bytes_per_state": round(res.bytes_per_state, 1),
+        "store_bytes_per_state": round(res.store_bytes_per_state, 1), "cpu_seconds": round(res.cpu, 3),
+        "peak_mb": round(res.peak_bytes / 2 ** 20, 1), "times": {k: round(v, 3) for k, v in res.times.items()},
         "tick_us": m.tick_us, "invariants": [i.name for i in m.invariants],
         "responses": {r.name: res.bounds.get(r.name, "not checked") for r in m.responses},
         "never_fired": res.never_fired, "warnings": res.warnings, "notes": m.notes,
@@ -81,11 +83,15 @@ def text(res: Result) -> str:
     m, s = res.model, summary(res)
     lines = [f"model {m.name}",
              f"  states {res.states:,}  transitions {res.transitions:,}  depth {res.depth}  "
-             f"{res.seconds:.2f} s ({res.rate:,.0f} states/s)  {res.bytes_per_state:.0f} bytes/state",
-             "  time " + "  ".join(f"{k} {v:.2f} s" for k, v in res.times.items())]
+             f"{res.seconds:.2f} s wall ({res.rate:,.0f} states per CPU s)  {res.bytes_per_state:.0f} bytes/state "
+             f"(peak +{res.peak_bytes / 2 ** 20:.0f} MB; stored graph {res.store_bytes_per_state:.0f} bytes/state)",
+             "  CPU time " + "  ".join(f"{k} {v:.2f} s" for k, v in res.times.items()) + f"  ({res.cpu:.2f} s in all)"]
     for note in m.notes:
         lines.append(f"  note: {note}")
-    if res.ok:
+    if res.ok and not res.proof:
+        lines.append(f"  no violation of {', '.join(i.name for i in m.invariants) or '-'} or deadlock "
+                     "in the states searched")
+    elif res.ok:
         lines.append(f"  invariants hold: {', '.join(i.name for i in m.invariants) or '-'}")
         lines.append("  no deadlock")
         for name, b in res.bounds.items():
@@ -107,6 +113,10 @@ def text(res: Result) -> str:
         lines += ["    " + x for x in s["mermaid"].splitlines()]
     elif not meets_deadline(res):
         lines.append("  BOUND EXCEEDED")
+    elif not res.proof:
+        lines.append("  NO VIOLATION FOUND (bitstate search: NOT a proof, see the estimate above)")
+    elif m.responses and not res.bounds:
+        lines.append("  SAFETY PROPERTIES HOLD (responses not checked)")
     else:
         lines.append("  ALL PROPERTIES HOLD")
     return "\n".join(lines)
@@ -127,7 +137,14 @@ def run_check(args) -> int:
                           args.scope)
     results, ok = [], True
     for model in models:
-        res = explore(model, progress=not args.quiet)
+        if getattr(args, "bitstate", None):
+            from model_check.bitstate import explore_bitstate
+            res, _ = explore_bitstate(model, args.bitstate, progress=not args.quiet)
+        elif getattr(args, "workers", 1) > 1:
+            from model_check.parallel import explore_parallel
+            res = explore_parallel(model, args.workers, progress=not args.quiet)
+        else:
+            res = explore(model, progress=not args.quiet)
         ok &= res.ok and meets_deadline(res)
         results.append(res)
         res.release()              # the graph is no longer needed: keep memory flat over `check all`

@@ -27,12 +27,28 @@ def register(sub) -> None:
     c.add_argument("--spec", default=None, help="spec directory (default: the repository's spec/)")
     c.add_argument("--json", action="store_true", help="print the results as JSON")
     c.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+    c.add_argument("--workers", type=_positive, default=1, metavar="N",
+                   help="search on N processes with a partitioned visited set (safety only: invariants, "
+                        "deadlocks, coverage; the same counts and verdicts as one process)")
+    c.add_argument("--bitstate", type=_bits, default=None, metavar="BITS",
+                   help="bitstate search in 2^BITS bits of memory (%d..%d), safety only; prints the expected "
+                        "omissions: a pass is then NOT a proof" % (BITSTATE_MIN, BITSTATE_MAX))
     c.set_defaults(func=_check)
     t = sub.add_parser("timing", help="worst-case POST, whisker-to-STOP and scan times from the spec")
     t.add_argument("--scope", choices=("colliders", "all"), default=None, help="override the backoff scope")
     t.add_argument("--spec", default=None, help="spec directory")
     t.add_argument("--json", action="store_true")
     t.set_defaults(func=_timing)
+
+
+BITSTATE_MIN, BITSTATE_MAX = 10, 36       # 128 B .. 8 GiB of bits
+
+
+def _bits(text: str) -> int:
+    value = _positive(text)
+    if not BITSTATE_MIN <= value <= BITSTATE_MAX:
+        raise argparse.ArgumentTypeError(f"must be {BITSTATE_MIN} .. {BITSTATE_MAX}: {value}")
+    return value
 
 
 def _positive(text: str) -> int:
@@ -116,6 +132,8 @@ def _check(args) -> int:
     _check_options(args, spec)
     if args.promela:
         _check_promela_dir(args.promela)
+    if args.workers > 1 and args.bitstate:
+        raise UserError("--workers and --bitstate: choose one (the bitstate search runs on one process)")
     try:
         return run_check(args)
     except OSError as exc:                  # e.g. the --promela folder filled up or vanished mid-run

@@ -20,6 +20,8 @@ from model_check.liveness import check_responses
 from model_check.storage import Meter, StateStore
 from model_check.trace import Step, Violation, concretise, follow
 
+SLICE = 1 << 15          # frontier states expanded per call of the generated `edges`
+
 __all__ = ["Result", "Step", "Violation", "explore", "trace_to", "concretise", "follow", "depth_of"]
 
 
@@ -37,8 +39,11 @@ class Result:
     warnings: list[str] = field(default_factory=list)
     store: StateStore | None = None           # the explored graph (None once released)
     layer_starts: list[int] = field(default_factory=list)   # first id of each breadth-first layer
-    times: dict[str, float] = field(default_factory=dict)    # search / bounds / liveness seconds
+    times: dict[str, float] = field(default_factory=dict)    # search / bounds / liveness CPU seconds
     peak_bytes: int = 0                        # resident memory the check added at its peak
+    store_bytes: int = 0                       # bytes of the stored graph (states, parents, edges)
+    cpu: float = 0.0                           # CPU seconds of the whole check (search and properties)
+    proof: bool = True                         # False after a bitstate search: a pass proves nothing
 
     @property
     def ok(self) -> bool:
@@ -50,11 +55,19 @@ class Result:
 
     @property
     def rate(self) -> float:
-        return self.states / self.seconds if self.seconds > 0 else float("inf")
+        """States per CPU second of the search (wall seconds mislead on a shared machine)."""
+        cpu = self.times.get("search", self.seconds)
+        return self.states / cpu if cpu > 0 else float("inf")
 
     @property
     def bytes_per_state(self) -> float:
+        """Resident peak per state: the figure that matters on big models (fixed overheads
+        dominate it on tiny ones, where `store_bytes_per_state` is the per-state cost)."""
         return self.peak_bytes / max(self.states, 1)
+
+    @property
+    def store_bytes_per_state(self) -> float:
+        return self.store_bytes / max(self.states, 1)
 
     @property
     def layers(self) -> list[list[int]]:
@@ -104,7 +117,7 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
                             "reduced graph are not a proof")
     meter = Meter()
     bar = Progress(model.name) if progress else None
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     store = StateStore(comp.layout.total_bits, len(model.rules))
     store.add_initial(comp.init)
     frontier, lo = [comp.init], 0
@@ -112,13 +125,20 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
     hit = None
     edges = comp.edges
     while frontier:
-        nxt: list[int] = []
-        rules: list[int] = []
-        ends: list[int] = []
-        hit = edges(frontier, nxt, rules, ends)
-        new = store.add_layer(lo, nxt, rules, ends)
+        # a wide layer goes in slices: the successor lists and their dedup dicts are the search's
+        # biggest Python objects; slicing changes nothing (the table dedups across slices, and ids,
+        # parents and the next frontier come out in the same first-seen order)
+        new = []
+        for a in range(0, len(frontier), SLICE):
+            nxt: list[int] = []
+            rules: list[int] = []
+            ends: list[int] = []
+            hit = edges(frontier[a:a + SLICE], nxt, rules, ends)
+            new += store.add_layer(lo + a, nxt, rules, ends)
+            if hit is not None:
+                hit_id = lo + a + len(ends)
+                break
         if hit is not None:
-            hit_id = lo + len(ends)
             break
         lo += len(frontier)
         frontier = new
@@ -126,10 +146,11 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
             res.layer_starts.append(lo + len(frontier))
         if bar:
             bar.update(len(res.layer_starts) - 2, len(store), len(frontier))
+    res.store_bytes = store.nbytes         # before finish drops the hash table: the search's peak
     store.finish()
     res.store = store
     res.seconds = time.perf_counter() - t0
-    res.times["search"] = res.seconds
+    res.times["search"] = time.process_time() - c0     # CPU seconds: comparable on a busy machine
     res.coverage = store.coverage()
     res.states, res.transitions, res.depth = len(store), sum(res.coverage), len(res.layer_starts) - 2
     try:
@@ -139,7 +160,9 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
             res.violation = Violation(kind, prop, concretise(comp, store.states(store.path_to(hit_id))))
             return res
         if model.final_checks:
+            c1 = time.process_time()
             _final_checks(res)
+            res.times["final checks"] = time.process_time() - c1
             if res.violation:
                 return res
         if check_liveness and model.responses:
@@ -147,6 +170,7 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
         return res
     finally:
         res.peak_bytes = meter.peak()
+        res.cpu = time.process_time() - c0
 
 
 def _final_checks(res: Result) -> None:

@@ -26,7 +26,7 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
-from model_check.storage import ranges
+from model_check.storage import pieces, ranges
 from model_check.trace import Violation, concretise, follow
 
 if TYPE_CHECKING:
@@ -48,7 +48,7 @@ class _Graph:
 
     def __init__(self, res: Result):
         model, store = res.model, res._graph()
-        t = time.perf_counter()
+        t = time.process_time()
         self.actors = [r.actor for r in model.rules]
         groups = sorted({a for a in self.actors if a is not None})
         if len(groups) > 64:       # pragma: no cover - no model comes close
@@ -62,8 +62,14 @@ class _Graph:
         _tick(res, "liveness", t)
 
 
+def _sinks(off: np.ndarray, ids: np.ndarray) -> np.ndarray:
+    """The states among `ids` without a successor, a slice at a time."""
+    out = [part[off[part + 1] == off[part]] for part in np.array_split(ids, max(1, len(ids) >> 20))]
+    return np.concatenate(out) if out else ids[:0]
+
+
 def _tick(res: Result, key: str, since: float) -> float:
-    now = time.perf_counter()
+    now = time.process_time()
     res.times[key] = res.times.get(key, 0.0) + now - since
     return now
 
@@ -73,9 +79,9 @@ def check_response(res: Result, index: int, graph: _Graph | None = None) -> tupl
     model, comp, store = res.model, res.compiled, res._graph()
     resp = model.responses[index]
     off, dst, rule = store.offsets, store.dst.view, store.rule.view
-    t = time.perf_counter()
+    t = time.process_time()
     goal = store.mask(comp.layout, model.defs, resp.goal)
-    roots = np.flatnonzero(store.mask(comp.layout, model.defs, resp.trigger) & ~goal)
+    roots = np.flatnonzero(store.mask(comp.layout, model.defs, resp.trigger) & ~goal).astype(np.int32)
     if not roots.size:
         _tick(res, "liveness", t)
         return 0, None
@@ -84,43 +90,47 @@ def check_response(res: Result, index: int, graph: _Graph | None = None) -> tupl
     in_b[roots] = True
     fr = roots
     while fr.size:
-        v = dst[ranges(off, fr)]
-        v = np.unique(v[~goal[v] & ~in_b[v]])
-        in_b[v] = True
-        fr = v.astype(np.int64)
-    b = np.flatnonzero(in_b)
-    deg = off[b + 1] - off[b]
+        found = []
+        for part in pieces(off, fr):
+            v = dst[ranges(off, part)]
+            v = v[~goal[v] & ~in_b[v]]
+            in_b[v] = True
+            found.append(v)
+        fr = np.unique(np.concatenate(found)).astype(np.int32)
+    b = np.flatnonzero(in_b).astype(np.int32)       # int32 ids: these arrays can span every state
     sub = _SubGraph(store, goal, b)
-    terminal = b[deg == 0]            # the run ends (a final state) without reaching the goal
+    terminal = _sinks(off, b)        # the run ends (a final state) without reaching the goal
     if terminal.size:
         _tick(res, "liveness", t)
         return None, _lasso(res, resp.name, roots, sub, [int(terminal[0])], [], graph, True)
-    # per state of B: edges staying in B, and the most ticks of an edge leaving it (into goal);
-    # edges into goal are few, so they are found once and subtracted (no per-edge int arrays)
-    leave = np.flatnonzero(goal[dst])
-    leave = leave[in_b[np.searchsorted(off, leave, side="right") - 1]]
-    src = np.searchsorted(off, leave, side="right") - 1
+    # per state of B: edges staying in B, and the most ticks of an edge leaving it (into goal),
+    # a slice of B at a time so that no array has one entry per edge
     outdeg = np.zeros(len(store), np.int32)
-    outdeg[b] = deg
-    np.subtract.at(outdeg, src, 1)
     longest = np.zeros(len(store), np.int32)
-    np.maximum.at(longest, src, graph.ticks[rule[leave]])
-    del leave, src
+    for part in pieces(off, b):
+        e = ranges(off, part)
+        into = goal[dst[e]]
+        src = np.repeat(part, off[part + 1] - off[part])
+        outdeg[part] = np.bincount(src[~into] - part[0], minlength=int(part[-1] - part[0] + 1))[part - part[0]]
+        np.maximum.at(longest, src[into], graph.ticks[rule[e[into]]])
     t = _tick(res, "liveness", t)
     # peel B from its sinks: longest tick path where acyclic; what is left reaches a cycle
     ready = b[outdeg[b] == 0]
     peeled = 0
-    rev_deg = np.diff(graph.rev_ptr)
     while ready.size:
         peeled += ready.size
-        e = ranges(graph.rev_ptr, ready)
-        via = np.repeat(longest[ready], rev_deg[ready])
-        u = graph.rev_src[e]
-        keep = in_b[u]
-        u = u[keep]
-        np.maximum.at(longest, u, graph.ticks[graph.rev_rule[e[keep]]] + via[keep])
-        uu, cnt = np.unique(u, return_counts=True)
-        outdeg[uu] -= cnt
+        touched = []
+        for part in pieces(graph.rev_ptr, ready):
+            e = ranges(graph.rev_ptr, part)
+            via = np.repeat(longest[part], graph.rev_ptr[part + 1] - graph.rev_ptr[part])
+            u = graph.rev_src[e]
+            keep = in_b[u]
+            u = u[keep]
+            np.maximum.at(longest, u, graph.ticks[graph.rev_rule[e[keep]]] + via[keep])
+            uu, cnt = np.unique(u, return_counts=True)
+            outdeg[uu] -= cnt
+            touched.append(uu)
+        uu = np.unique(np.concatenate(touched))
         ready = uu[outdeg[uu] == 0]
     if peeled == len(b):
         _tick(res, "bounds", t)

@@ -1,8 +1,10 @@
 """Compact storage of the explored state graph (issue 12): numpy arrays, no per-state objects.
 
-A state is the model's packed int (compile.Layout); here it is kept as `words`
-little-endian 64-bit words, one row per state, numbered in breadth-first,
-first-seen order (the state id). Beside the rows:
+A state is the model's packed int (compile.Layout); here it is kept as
+ceil(bits / 8) little-endian bytes, one row per state (17 bytes for id_retry's
+129 bits, not three 64-bit words), numbered in breadth-first, first-seen order
+(the state id); hashing and bit-field reads widen a slice of rows to 64-bit
+words on the fly. Beside the rows:
 
 - an open-addressing hash table of ids (int32, triangular probing, load <= 0.7),
   used while searching and dropped afterwards;
@@ -17,13 +19,15 @@ The generated `edges` function (fastgen) appends every successor of a layer to
 a plain list; `add_layer` deduplicates that list in bulk with numpy (sort within
 the layer, then probe the table in vectorised rounds), which is where the time
 per edge goes from a Python set lookup to a few numpy element operations.
-About 60 bytes per state for a 3-word model (24 for the key, 8 for the table,
-~16 for edges, 4 for the parent, 1-2 for the degree), against roughly 80 for a
-Python set of ints alone.
+About 50 bytes per state for id_retry (17 for the key, 8 for the table while
+searching, ~16 for edges, 4 for the parent, 4 for the CSR offsets), against
+roughly 80 for a Python set of ints alone.
 """
 from __future__ import annotations
 
 import ast
+import ctypes
+import ctypes.util
 from itertools import repeat
 from typing import Callable
 
@@ -32,6 +36,7 @@ import numpy as np
 from model_check import expr
 
 LOAD = 0.7                          # grow the hash table beyond this fill
+REHASH = 1 << 18                    # states re-inserted per vectorised step when the table grows
 _M1 = np.uint64(0x9E3779B97F4A7C15)  # Fibonacci hashing multiplier
 _M2 = np.uint64(0xBF58476D1CE4E5B9)  # splitmix64 constants, to mix the words of a key
 _M3 = np.uint64(0x94D049BB133111EB)
@@ -45,6 +50,7 @@ class Meter:
     the figure falls back to the current RSS at the end (an under-estimate of the peak)."""
 
     def __init__(self) -> None:
+        _trim()
         try:
             with open("/proc/self/clear_refs", "w") as fh:
                 fh.write("5")
@@ -56,6 +62,15 @@ class Meter:
     def peak(self) -> int:
         top = _status("VmHWM") if self.reset else _status("VmRSS")
         return max(0, top - self.base)
+
+
+def _trim() -> None:
+    """Give the C heap's free pages back to the system (glibc malloc_trim), so that arrays of
+    the check cannot hide in memory an earlier step freed and the peak counts them all."""
+    try:
+        ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):       # not glibc: the peak may then under-count
+        pass
 
 
 def _status(key: str) -> int:
@@ -71,11 +86,13 @@ def _status(key: str) -> int:
 
 
 class Grow:
-    """An append-only numpy array with amortised doubling.
+    """An append-only numpy array grown in place by 1/4 at a time.
 
-    Pages past the end are never written and so not resident; growing copies, so the old
-    and the new array are both resident for a moment (`ndarray.resize` would avoid the
-    copy but zero-fills the whole new capacity, which made the peak larger)."""
+    `ndarray.resize` reallocates, which for a large (mmap-backed) block is an mremap: no
+    copy, so the old and the new array are never both resident (a copying doubling put
+    one whole extra array on top of the peak). It zero-fills the new capacity, which is
+    therefore resident at once; growing by a quarter bounds that slack to 25 %.
+    A view taken before an `append` or `trim` is invalid after it (the block may have moved)."""
 
     def __init__(self, dtype, width: int = 0, capacity: int = 1024):
         self.width = width
@@ -85,16 +102,40 @@ class Grow:
     def append(self, chunk: np.ndarray) -> None:
         need = self.n + len(chunk)
         if need > len(self.data):
-            cap = max(need, 2 * len(self.data))
-            new = np.empty((cap, self.width) if self.width else cap, self.data.dtype)
-            new[:self.n] = self.data[:self.n]
-            self.data = new
+            cap = max(need, len(self.data) + len(self.data) // 4)
+            self.data.resize((cap, self.width) if self.width else cap, refcheck=False)
         self.data[self.n:need] = chunk
         self.n = need
+
+    def trim(self) -> None:
+        """Capacity down to the length (no more appends are expected; they would still work)."""
+        self.data.resize((max(self.n, 1), self.width) if self.width else max(self.n, 1), refcheck=False)
 
     @property
     def view(self) -> np.ndarray:
         return self.data[:self.n]
+
+
+def mix64(rows: np.ndarray, seed: np.uint64 = np.uint64(0)) -> np.ndarray:
+    """A 64-bit hash of each row of uint64 words (Fibonacci multiply, splitmix64 finaliser);
+    a different `seed` gives an independent-looking second hash (bitstate's double hashing)."""
+    h = (rows[:, 0] ^ seed) * _M1
+    for w in range(1, rows.shape[1]):
+        h = (h ^ (h >> np.uint64(31)) ^ rows[:, w]) * _M2
+    return (h ^ (h >> np.uint64(29))) * _M3
+
+
+def pieces(offsets: np.ndarray, ids: np.ndarray, edges: int = 1 << 20):
+    """`ids` cut into consecutive runs of at most about `edges` CSR edges each, so a
+    vectorised step over their edges needs bounded temporary memory (issue 12)."""
+    if ids.size == 0:
+        return
+    cum = np.cumsum(offsets[ids + 1] - offsets[ids])
+    if cum[-1] <= edges:
+        yield ids
+        return
+    cuts = np.searchsorted(cum, np.arange(edges, int(cum[-1]), edges), side="right")
+    yield from np.split(ids, np.unique(cuts))
 
 
 def ranges(offsets: np.ndarray, ids: np.ndarray) -> np.ndarray:
@@ -112,7 +153,8 @@ class StateStore:
 
     def __init__(self, total_bits: int, rules: int):
         self.words = max(1, -(-total_bits // 64))
-        self.keys = Grow(np.uint64, self.words, 1 << 12)
+        self.width = max(1, -(-total_bits // 8))      # stored bytes per state: no padding to words
+        self.keys = Grow(np.uint8, self.width, 1 << 12)
         self.parent = Grow(np.int32, 0, 1 << 12)
         self.degree = Grow(np.uint16, 0, 1 << 12)
         self.dst = Grow(np.int32, 0, 1 << 14)
@@ -134,7 +176,7 @@ class StateStore:
 
     def state(self, i: int) -> int:
         """The packed state with id `i`."""
-        return int.from_bytes(self.keys.view[i].astype("<u8").tobytes(), "little")
+        return int.from_bytes(self.keys.view[i].tobytes(), "little")
 
     def states(self, ids) -> list[int]:
         return [self.state(int(i)) for i in ids]
@@ -142,18 +184,24 @@ class StateStore:
     def index_of(self, state: int) -> int:
         """Id of a stored state (a linear scan: for traces, not for the search)."""
         row = self.to_words([state])[0]
-        hit = np.flatnonzero((self.keys.view == row).all(axis=1))
+        hit = np.flatnonzero((self.keys.view == self._pack(row[None])[0]).all(axis=1))
         if not hit.size:
             raise KeyError(state)
         return int(hit[0])
 
+    def _pack(self, rows: np.ndarray) -> np.ndarray:
+        """uint64 word rows -> the stored rows of `width` bytes (little-endian, padding dropped)."""
+        return rows.astype("<u8", copy=False).view(np.uint8).reshape(len(rows), 8 * self.words)[:, :self.width]
+
+    def _unpack(self, rows: np.ndarray) -> np.ndarray:
+        """Stored byte rows -> uint64 word rows, for hashing and bit-field arithmetic."""
+        out = np.zeros((len(rows), 8 * self.words), np.uint8)
+        out[:, :self.width] = rows
+        return out.view("<u8").astype(np.uint64, copy=False)
+
     # -- hashing -------------------------------------------------------------------------
     def _hash(self, rows: np.ndarray) -> np.ndarray:
-        h = rows[:, 0] * _M1
-        for w in range(1, self.words):
-            h = (h ^ (h >> np.uint64(31)) ^ rows[:, w]) * _M2
-        h = (h ^ (h >> np.uint64(29))) * _M3
-        return h >> np.uint64(64 - self._bits)
+        return mix64(rows) >> np.uint64(64 - self._bits)
 
     @property
     def _bits(self) -> int:
@@ -165,10 +213,13 @@ class StateStore:
             return
         while need > LOAD * size:
             size *= 2
+        self.table = None                             # the old table goes before the new one comes
         self.table = np.full(size, -1, np.int32)
-        n = len(self)
-        slot = self._hash(self.keys.view).astype(np.int64)
-        self._claim(slot, np.arange(n, dtype=np.int32), lambda pending, ids: None)
+        keys = self.keys.view
+        for lo in range(0, len(self), REHASH):        # in slices: the hash temporaries stay small
+            rows = self._unpack(keys[lo:lo + REHASH])
+            self._claim(self._hash(rows).astype(np.int64), np.arange(lo, lo + len(rows), dtype=np.int32),
+                        lambda pending, ids: None)
 
     def _claim(self, slot: np.ndarray, values: np.ndarray, on_taken: Callable) -> np.ndarray:
         """Write `values` (distinct, >= 0 or marks <= -2) into free slots, probing in rounds.
@@ -207,7 +258,7 @@ class StateStore:
         first = len(self)
         self._grow_table(first + len(rows))
         ids = np.arange(first, first + len(rows), dtype=np.int32)
-        self.keys.append(rows)
+        self.keys.append(self._pack(rows))
         self.parent.append(parents)
         self._claim(self._hash(rows).astype(np.int64), ids, lambda pending, cur: None)
 
@@ -229,29 +280,7 @@ class StateStore:
         number = dict(zip(distinct, range(len(distinct))))
         inv = np.fromiter(map(number.__getitem__, nxt), np.int64, len(nxt))
         del number
-        reps = self.to_words(distinct)
-        # probe the table: existing ids, or a mark (-2 - k) claiming a free slot for new key k
-        self._grow_table(len(self) + len(reps))
-        ids = np.full(len(reps), -1, np.int64)
-        keys = self.keys.view
-
-        def seen(pending: np.ndarray, cur: np.ndarray) -> np.ndarray:
-            eq = cur >= 0
-            old, at = pending[eq], cur[eq]
-            same = keys[at, 0] == reps[old, 0]
-            for w in range(1, self.words):
-                same &= keys[at, w] == reps[old, w]
-            eq[eq] = same
-            ids[pending[eq]] = cur[eq]
-            return eq
-
-        slot = self._hash(reps).astype(np.int64)
-        marks = (-2 - np.arange(len(reps))).astype(np.int32)
-        new = np.flatnonzero(~self._claim(slot, marks, seen))     # ascending = first-seen order
-        base = len(self)
-        ids[new] = np.arange(base, base + len(new))
-        self.table[slot[new]] = ids[new]                       # type: ignore[index]
-        self.keys.append(reps[new])
+        ids, new = self._insert_distinct(self.to_words(distinct))
         # the parent of a new state is the source of the first edge reaching it; successors are
         # numbered in first-seen order, so a first occurrence is where the running maximum grows
         top = np.maximum.accumulate(inv)
@@ -261,13 +290,46 @@ class StateStore:
         self.dst.append(ids[inv].astype(np.int32))
         return [distinct[i] for i in new.tolist()]
 
-    def finish(self, keep_table: bool = False) -> None:
-        """The search is over: drop the hash table (unless asked) and the degrees for CSR offsets.
+    def add_states(self, states: list[int]) -> list[int]:
+        """As a bare visited set (the parallel search's workers): insert `states` and return the
+        new ones in first-seen order; no parents, no edges."""
+        distinct = list(dict.fromkeys(states))
+        if not distinct:
+            return []
+        _, new = self._insert_distinct(self.to_words(distinct))
+        return [distinct[i] for i in new.tolist()]
 
-        The arrays are not trimmed: the unused tail of each was never written, so it is not
-        resident, and a trimming copy would double the peak."""
+    def _insert_distinct(self, reps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """For distinct rows `reps`: the id of each (stored or newly given) and which are new."""
+        # probe the table: existing ids, or a mark (-2 - k) claiming a free slot for new key k
+        self._grow_table(len(self) + len(reps))
+        ids = np.full(len(reps), -1, np.int64)
+        keys = self.keys.view
+        packed = self._pack(reps)
+
+        def seen(pending: np.ndarray, cur: np.ndarray) -> np.ndarray:
+            eq = cur >= 0
+            old, at = pending[eq], cur[eq]
+            eq[eq] = (keys[at] == packed[old]).all(axis=1)
+            ids[pending[eq]] = cur[eq]
+            return eq
+
+        slot = self._hash(reps).astype(np.int64)
+        marks = (-2 - np.arange(len(reps))).astype(np.int32)
+        new = np.flatnonzero(~self._claim(slot, marks, seen))     # ascending = first-seen order
+        base = len(self)
+        ids[new] = np.arange(base, base + len(new))
+        self.table[slot[new]] = ids[new]                       # type: ignore[index]
+        self.keys.append(packed[new])
+        return ids, new
+
+    def finish(self, keep_table: bool = False) -> None:
+        """The search is over: drop the hash table (unless asked) and the degrees for CSR offsets,
+        and give back the zero-filled tail of every array (a shrinking realloc: no copy)."""
         if not keep_table:
             self.table = None
+        for g in (self.keys, self.parent, self.dst, self.rule):
+            g.trim()
         deg = self.degree.view
         self.offsets = np.zeros(len(deg) + 1, np.int32 if self.dst.n < 2 ** 31 else np.int64)
         np.cumsum(deg, out=self.offsets[1:])
@@ -293,7 +355,7 @@ class StateStore:
     def field(self, shift: int, width: int, lo: int, hi: int) -> np.ndarray:
         """The values of one bit field of states lo .. hi-1, as int64."""
         word, off = divmod(shift, 64)
-        keys = self.keys.view[lo:hi]
+        keys = self._unpack(self.keys.view[lo:hi])
         v = keys[:, word] >> np.uint64(off)
         if off + width > 64:
             v = v | (keys[:, word + 1] << np.uint64(64 - off))

@@ -68,3 +68,22 @@ def test_edges_and_coverage_match_the_compiled_successors():
         got = list(zip(store.rule.view[lo:hi].tolist(), store.states(store.dst.view[lo:hi])))
         assert got == [(r, comp.canon(ns)) for r, ns in comp.successors(s)]
     assert res.bytes_per_state >= 0 and set(res.times) == {"search", "bounds", "liveness"}
+
+
+def test_slicing_wide_layers_changes_nothing(monkeypatch):
+    """The engine expands a wide layer in slices; ids, parents, edges and verdicts stay the same."""
+    from model_check import engine
+    from tests.model_check import toys
+    spec = sa.load()
+    for model in (id_retry.build(sa.identification(spec, "sensor"), 2), toys.mutex(3, lock=False)):
+        whole = explore(model, progress=False)
+        monkeypatch.setattr(engine, "SLICE", 3)
+        sliced = explore(model, progress=False)
+        monkeypatch.undo()
+        assert (sliced.states, sliced.transitions, sliced.depth, sliced.coverage, sliced.bounds) == \
+            (whole.states, whole.transitions, whole.depth, whole.coverage, whole.bounds)
+        assert sliced.store.parent.view.tolist() == whole.store.parent.view.tolist()
+        assert sliced.store.dst.view.tolist() == whole.store.dst.view.tolist()
+        assert (sliced.violation is None) == (whole.violation is None)
+        if whole.violation:
+            assert [s.state for s in sliced.violation.trace] == [s.state for s in whole.violation.trace]

@@ -49,3 +49,14 @@ def tokens(n: int = 4, hi: int = 2) -> Model:
     vs = [Var(f"c{i}", hi) for i in range(n)]
     rules = [Rule(f"bump{i}", f"c{i} < {hi}", ((f"c{i}", f"c{i} + 1"),)) for i in range(n)]
     return Model("tokens", vs, rules, final="True", symmetry=[SymGroup("counters", tuple((f"c{i}",) for i in range(n)))])
+
+
+def torus(n: int = 4, size: int = 16) -> Model:
+    """n counters modulo `size`, each stepped up or down: size ** n states, every one with 2n
+    predecessors, so losing one state in a bitstate search cuts off nothing else."""
+    vs = [Var(f"c{i}", size - 1) for i in range(n)]
+    rules = []
+    for i in range(n):
+        rules += [Rule(f"up{i}", "True", ((f"c{i}", f"(c{i} + 1) % {size}"),)),
+                  Rule(f"down{i}", "True", ((f"c{i}", f"(c{i} + {size - 1}) % {size}"),))]
+    return Model("torus", vs, rules, final="True")
