@@ -78,6 +78,7 @@ class OccupancyGrid:
         self.logodds = [0.0] * (self.nx * self.ny)
         self.seen = bytearray(self.nx * self.ny)       # ever crossed by a beam: coverage only grows
         self.hit, self.miss, self.limit = 0.9, -0.4, 5.0
+        self.barriers: set[tuple[int, int]] = set()      # pit edges and refused slopes (mark_barrier): never cleared
 
     # -- coordinates ----------------------------------------------------------------
     def cell(self, x: float, y: float) -> tuple[int, int]:
@@ -100,9 +101,21 @@ class OccupancyGrid:
 
     # -- updates --------------------------------------------------------------------
     def _bump(self, i: int, j: int, delta: float) -> None:
+        if (i, j) in self.barriers:
+            return
         k = j * self.nx + i
         self.logodds[k] = max(-self.limit, min(self.limit, self.logodds[k] + delta))
         self.seen[k] = 1
+
+    def mark_barrier(self, x: float, y: float) -> None:
+        """A foot found no ground here (seed 1.2.2) or the ground rises too steeply (3.2.14): the cell is as
+        impassable as a wall, for good."""
+        i, j = self.cell(x, y)
+        if self.inside(i, j):
+            k = j * self.nx + i
+            self.logodds[k] = self.limit
+            self.seen[k] = 1
+            self.barriers.add((i, j))
 
     def mark_free(self, x: float, y: float, radius_m: float) -> None:
         """The robot stands here: the cells under its body are free (and seen)."""

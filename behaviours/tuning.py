@@ -84,7 +84,11 @@ NP3_BATTERY_LOW_COUNT = 3     # ... this many times in a row (or its ALARM) -> s
 NP3_LEG_BLOCKED_HOLD_S = 0.8  # blocked leg (6.1): hold still while the LCP retracts and re-plans
 NP3_LEG_BLOCKED_SIDE_S = 0.8  # ... then sidestep this long away from the blocked leg's side
 NP3_AVOID_ECHO_M = 0.35       # avoidance: a remembered echo this far ahead of the body centre ...
-NP3_AVOID_HALF_WIDTH_M = 0.22 # ... within this of the body axis (the legs reach 0.2 m out) -> turn away
+NP3_AVOID_HALF_WIDTH_M = 0.16 # ... within this of the body axis (body 0.08 m, the legs' tips 0.2 m: a foot that
+                              # meets something is a blocked leg, seed 6.1, and a corridor 0.5 m wide stays passable)
+NP3_GUARD_MARGIN_M = 0.04    # motion check (5.1.2): no command may bring the body outline closer than this ...
+NP3_GUARD_HORIZON_S = 1.0     # ... to a remembered echo within this long (the gait takes a half cycle to stop);
+NP3_GUARD_HOLD_S = 0.3        # ... a refused command is replaced by a safe one this long
 NP3_SOUND_MIN_DEG = 10        # sound straight ahead within this: no turn needed
 NP3_EXPLORE_PLAN_S = 10.0     # explore: a new goal every 10 s (5.2: navigation 10..30 s) or when reached:
 NP3_EXPLORE_HEADINGS = 16     # ... the best of this many headings round the robot, scored on the map by

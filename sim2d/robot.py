@@ -28,6 +28,7 @@ from sim2d.world import BODY, OBSTACLE, WALL, World
 
 CONTACT_EPS = 0.002   # a foot within 2 mm of the ground touches it
 LEG_REACH = 0.45      # body centre to the farthest foot, with margin
+SLIDE_M = 0.005       # a foot lowered along a wall it touches may drift this far sideways per step
 
 
 @dataclass
@@ -192,7 +193,10 @@ class Robot:
                     solid = self.world.solid_height_at(wx, wy)
                     # from the side (the foot was below the top before): it hits the obstacle;
                     # from above: it lands on top (contact below)
-                    if solid > fz + CONTACT_EPS and old_foot[2] < solid - CONTACT_EPS:
+                    # a foot pressed against a wall's face still slides down it: lowering (with at most
+                    # SLIDE_M of sideways drift) is not a hit, else it would hang there and report no ground
+                    sliding = fz < old_foot[2] and math.dist(leg.world, old_world) < SLIDE_M
+                    if solid > fz + CONTACT_EPS and old_foot[2] < solid - CONTACT_EPS and not sliding:
                         # seed 6.1: the swing foot hits an obstacle; the servos stall
                         for j, a in zip(leg.joints, old):
                             j.angle, j.speed = a, 0.0
