@@ -119,6 +119,7 @@ class NP3(Runtime, Np3Skeleton):
         self.lux: list[float] = []
         self.next_plan = 0.0
         self.goal: tuple[float, float] | None = None
+        self.routes_planned = 0               # routes planned over the topological map (3.3.2)
         self.visited: set[tuple[int, int]] = set()
         self.last_cell: tuple[int, int] | None = None
         self.every(T.NP3_PERIOD_S, self.tick)
@@ -183,11 +184,27 @@ class NP3(Runtime, Np3Skeleton):
         return True
 
     def plan_goal(self, now: float) -> None:
-        """seed 3.3.2 / 5.2: every NP3_EXPLORE_PLAN_S, or when the goal is reached, pick the heading whose ray
-        through the map runs longest over cells the robot has not passed yet before a mapped obstacle,
-        and set a goal along it (short of the obstacle)."""
-        self.next_plan = now + T.NP3_EXPLORE_PLAN_S
+        """seed 3.3.2 / 5.2: the task layer's next goal, every NP3_EXPLORE_PLAN_S or when it is reached.
+
+        First choice: the heading whose ray through the map runs longest over cells not passed yet before a
+        mapped obstacle, with a goal along it (short of the obstacle). When no heading is open (boxed in by
+        walls, pits, refused slopes) or a route is being followed, a route over the topological map to the
+        nearest frontier (free space bordering unknown space, at least NP3_PLAN_MIN_PATH_M away), waypoint
+        by waypoint; it is planned again (the map has changed) every NP3_EXPLORE_PLAN_S.
+        (Measured, issue 17: frontier routes as the first choice covered less of the explore room, 0.36-0.40
+        against 0.45-0.50 on seeds 1-3, so they are the way out, not the rule.)
+        """
         x, y, th = self.odo.pose
+        route = self.map.plan
+        if route and now < self.next_plan:
+            if math.dist(route[0], (x, y)) < T.NP3_GOAL_REACHED_M:
+                route.pop(0)
+            if route:
+                self.goal = route[0]
+                self.layers.sense(goal=self.goal)
+                return
+        self.next_plan = now + T.NP3_EXPLORE_PLAN_S
+        self.map.plan = []
         g = self.map.grid
         best: tuple[float, float, float] | None = None          # (score, heading, free length)
         for k in range(T.NP3_EXPLORE_HEADINGS):
@@ -202,12 +219,25 @@ class NP3(Runtime, Np3Skeleton):
             score = fresh + 0.2 * free - 0.3 * abs(turn)
             if free > T.NP3_EXPLORE_MARGIN_M and (best is None or score > best[0]):
                 best = (score, h, free)
-        if best is None:
-            self.goal = None
-        else:
+        if best is not None:
             length = min(best[2] - T.NP3_EXPLORE_MARGIN_M, T.NP3_EXPLORE_GOAL_M)
             self.goal = (x + length * math.cos(best[1]), y + length * math.sin(best[1]))
+        else:
+            self.goal = self.route_to_frontier(x, y)
         self.layers.sense(goal=self.goal)
+
+    def route_to_frontier(self, x: float, y: float) -> tuple[float, float] | None:
+        """seed 3.3.2: plan over the rebuilt topological map to the nearest frontier; its first waypoint."""
+        self.map.rebuild()
+        frontier = self.map.frontier(x, y, min_size=T.NP3_PLAN_MIN_FRONTIER, min_path_m=T.NP3_PLAN_MIN_PATH_M)
+        route = self.map.route((x, y), (frontier.x, frontier.y)) if frontier is not None else None
+        while route and math.dist(route[0], (x, y)) < T.NP3_GOAL_REACHED_M:
+            route.pop(0)
+        self.map.plan = route or []
+        if not route:
+            return None
+        self.routes_planned += 1
+        return route[0]
 
     def mark_visited(self, x: float, y: float) -> None:
         """The map cells within NP3_EXPLORE_SEEN_M of the dead-reckoned path (what exploring has covered)."""
@@ -262,10 +292,10 @@ class NP3(Runtime, Np3Skeleton):
             left = bool(v & (TpscContact.OBJ_LEFT | TpscContact.OBJ_BOTH))
             right = bool(v & (TpscContact.OBJ_RIGHT | TpscContact.OBJ_BOTH))
             self.bump("whisker", left, right, self.now)                 # seed 3.2.12
-            for side, hit in ((1.0, left), (-1.0, right)):              # the touch: half way along the whisker
-                if hit:
+            for side, hit in ((1.0, left), (-1.0, right)):   # the touch: anywhere along the whisker, so
+                for along in (0.2, 0.5, 0.85) if hit else ():     # points near its root, middle and tip
                     self.echo(T.NP3_BODY_FRONT_M, side * self.geo.body_width / 2, side * T.NP3_WHISKER_DEG,
-                              T.NP3_WHISKER_M / 2)
+                              along * T.NP3_WHISKER_M)
         elif role == "IRRC" and 0 <= ch < 3:                            # seed 3.2.13: beam 0 left, 1 centre, 2 right
             self.ir[ch] = None if v >= _Q["IRRC"].hi else decode(role, v) / 100
             if self.ir[ch] is not None:
@@ -384,7 +414,7 @@ class NP3(Runtime, Np3Skeleton):
             "battery_low": self.battery_low,
             "ir_fault": self.ir_fault,
             "sonar_ignored": self.sonar_ignored,
-            "map": {"places": len(self.map.places), "edges": len(self.map.edges),
+            "map": {"places": len(self.map.places), "edges": len(self.map.edges), "routes": self.routes_planned,
                     "seen_m2": round(sum(self.map.grid.seen) * self.map.grid.res ** 2, 2)},
             "light": {"first_lux": round(self.lux[0], 1), "last_lux": round(self.lux[-1], 1),
                       "ratio": round(self.lux[-1] / self.lux[0], 3)} if self.lux else {},
