@@ -155,3 +155,21 @@ def test_png_has_the_grid_size_and_shows_walls_places_and_unknown(tmp_path, squa
     assert pixel(-0.35, 3.0) == (160, 160, 160)
     colours = {rgb.getpixel((u, v)) for u in range(img.size[0]) for v in range(img.size[1])}
     assert (0, 0, 0) in colours and (220, 30, 30) in colours and (255, 255, 255) in colours
+
+
+def test_a_route_goes_round_through_the_door_and_never_through_the_wall(tmp_path):
+    closed, _ = two_rooms(door=False)
+    start, goal = (2.0, 3.3), (6.0, 3.3)                         # the straight line runs into the wall
+    assert closed.route(start, goal) is None                      # no door: no way
+    opened, walls = two_rooms(door=True)
+    route = opened.route(start, goal)
+    assert route is not None and route[-1] == goal
+    legs = list(zip([start] + route, route))
+    for a, b in legs[1:-1]:                                        # between places: the robot fits all the way
+        assert opened.passable(a, b)
+    crossing = [(a, b) for a, b in legs if (a[0] < 4) != (b[0] < 4)]
+    assert crossing and all(1.5 < (a[1] + b[1]) / 2 < 2.5 for a, b in crossing)    # through the door (y 1.5..2.5)
+    opened.plan = route
+    out = opened.save_png(tmp_path / "plan.png")
+    img = Image.open(out).convert("RGB")
+    assert any(img.getpixel((x, y)) == (0, 170, 60) for x in range(img.width) for y in range(0, img.height, 2))
