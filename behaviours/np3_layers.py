@@ -91,6 +91,7 @@ class Tuning:
     light_weave_s: float = T.NP3_LIGHT_WEAVE_S
     light_detour_step_deg: float = T.NP3_LIGHT_DETOUR_STEP_DEG
     light_detour_hold_s: float = T.NP3_LIGHT_DETOUR_HOLD_S
+    light_flat_log: float = T.NP3_LIGHT_FLAT_LOG
     turn_rate_deg_s: float = T.NP3_DR_TURN_DEG_S   # turn on the spot (measured; nominal 20 deg per 0.8 s)
     walk_speed_m_s: float = T.NP3_DR_SPEED_M_S
     body_half_length_m: float = T.NP3_BODY_FRONT_M
@@ -534,6 +535,11 @@ class TaskModule:
             self.plan = None                          # the probe has done its job: head for the light now
         self.gradient = fit or self.gradient
 
+    def dark(self) -> bool:
+        """A full set of light samples that differ by less than light_flat_log: no gradient to follow."""
+        logs = [s[2] for s in self.samples]
+        return len(logs) >= self.t.light_samples and max(logs) - min(logs) < self.t.light_flat_log
+
     def _seek_light(self, i: Mapping[str, Any], now: float) -> MovCmd:
         return self._light(i, now, sign=1.0)
 
@@ -549,10 +555,15 @@ class TaskModule:
         fit over the latest samples never degenerates into a line (a failed fit
         keeps the last direction). Each leg's heading is the one nearest the
         target whose corridor the echo memory shows clear: an obstacle across
-        the way is walked round along its edge (bug-style, seed 5.1.2).
+        the way is walked round along its edge (bug-style, seed 5.1.2). Seeking
+        a light none of the samples shows (all within light_flat_log: a lamp
+        behind a wall), the robot explores its map (planned routes, seed 3.3.2)
+        until it does.
         """
         t = self.t
         pose = i.get("pose")
+        if sign > 0 and self.dark():
+            return self._explore(i, now)
         ir = _seen(i.get("ir"))
         if self.gradient is None or pose is None:
             if any(d is not None for d in ir):

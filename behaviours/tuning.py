@@ -110,6 +110,8 @@ NP3_LIGHT_WEAVE_S = 8.0       # ... changing side this often (the fit needs samp
 NP3_LIGHT_CLEAR_M = 0.6       # ... on the heading nearest the target with this much clear in the echo memory,
 NP3_LIGHT_DETOUR_STEP_DEG = 20.0  # ... tried in steps this wide either side (bug-style round an obstacle)
 NP3_LIGHT_DETOUR_HOLD_S = 10.0   # ... keeping a detour's side this long after the last blocked heading
+NP3_LIGHT_FLAT_LOG = 0.02     # seeking light: samples spanning less than this (log10 lux, ~1 LSC step of 3.6 %)
+                              # show no light to climb (a lamp shaded by a wall): explore the map instead (3.3.2)
 NP3_MAP_SIZE_M = 12.0         # topological map: a square this wide around the start ...
 NP3_MAP_CELL_M = 0.1          # ... in cells this wide
 NP3_SONAR_BEAM_DEG = 15.0     # width a sonar echo is spread over on the map (40 kHz transducer cone)

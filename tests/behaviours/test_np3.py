@@ -195,6 +195,25 @@ def test_seek_light_samples_while_probing_and_stops_the_probe_once_the_gradient_
     assert out["move"] in (MovCmd.TURN_LEFT, MovCmd.FORWARD)           # ... for the light (+y: turn left)
 
 
+@pytest.mark.parametrize("rise, steers_to_goal", [(0.0, True), (0.05, False)])
+def test_seek_light_explores_towards_the_planned_goal_while_no_sample_shows_a_light(rise, steers_to_goal):
+    """A lamp shaded by a wall: the samples read the same everywhere, so the task layer follows the map's
+    goal (a route to the nearest frontier) instead of a gradient that is not there; a real gradient wins."""
+    t = Tuning()
+    task = TaskModule("seek_light", t)
+    goal = (0.0, -3.0)                                    # to the right of a robot facing +x
+    now = 0.0
+    for seq in range(1, t.light_samples + 1):            # an L of samples; log lux rises along +x by `rise`/step
+        x, y = (0.3 * seq, 0.0) if seq <= 4 else (1.2, 0.3 * (seq - 4))
+        task.plan = None
+        out = task.step({"light": (seq, x, y, 1.0 + rise * seq), "pose": (x, y, 0.0), "goal": goal}, now)
+        now += 2.5
+    assert task.dark() == steers_to_goal
+    task.plan = None
+    out = task.step({"pose": (1.2, 1.2, 0.0), "goal": goal}, now)
+    assert (out["move"] == MovCmd.TURN_RIGHT) == steers_to_goal
+
+
 def test_seek_light_walks_round_an_obstacle_on_one_side():
     t = Tuning()
     task = TaskModule("seek_light", t)
