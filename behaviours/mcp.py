@@ -60,7 +60,6 @@ class MCP(PostMaster, Runtime, McpSkeleton):
         self.mmc_state: tuple[int, int] | None = None       # (error, leg) last told to the NP3
         self.faults: dict[tuple[int, int], int] = {}         # (source, channel) -> last non-zero status relayed
         self.polling_mmc = False
-        self.moves_relayed = 0                               # relay_move: a retry of a superseded MOVE is dropped
         self.battery_low = False
         self.led_on = False
         self.last_obstacle_msg = -1e9
@@ -131,8 +130,7 @@ class MCP(PostMaster, Runtime, McpSkeleton):
     def _record(self, src: int, msg: M.Message) -> None:
         if isinstance(msg, M.Move):
             if not self.halted:         # seed 3.2.2: a halted robot stays stopped
-                # seed 5.2: the NP3's MOVE is a record fetched like any other: relayed before the next grant
-                self.relay_move(src, msg.mov_cmd, msg.param, 1 + self.net.protocol.move_retries, PRIORITY_RELAY)
+                self.relay_move(src, msg.mov_cmd, msg.param, 1 + self.net.protocol.move_retries)
         elif isinstance(msg, M.PostReq):
             self.on_post_req(src, msg)
         elif isinstance(msg, M.XmitRecord) and msg.target == ADDRESS_OF["NP3"]:
@@ -154,16 +152,13 @@ class MCP(PostMaster, Runtime, McpSkeleton):
 
     def relay_move(self, src: int, mov_cmd: int, param: int, attempts: int, priority: int = 0) -> None:
         """MOVE_RELAYED has no reply of its own: the MMC's STATUS_ACK (gait, direction) confirms it.
-        `priority` (a reflex's): both go ahead of everything of a lower one not yet on the wire. A MOVE relayed
-        since supersedes this one: it is not resent (the MMC would run an outdated command until the next)."""
+        `priority` (a reflex's): both go ahead of everything of a lower one not yet on the wire."""
         mmc = ADDRESS_OF["MMC"]
-        self.moves_relayed += 1
-        serial = self.moves_relayed
 
         def check(s: int, ack: M.StatusAckMmc) -> None:
             self.mmc_status(ack)
             applied = ack.gait == mov_cmd if mov_cmd in _GAITS else ack.direction == mov_cmd
-            if not applied and attempts > 1 and serial == self.moves_relayed:   # spec protocol.move_retries
+            if not applied and attempts > 1:       # spec protocol.move_retries
                 self.relay_move(src, mov_cmd, param, attempts - 1, priority)
         self.request(mmc, M.MoveRelayed(address=src, mov_cmd=mov_cmd, param=param), priority=priority)
         self.request(mmc, M.StatusReq(), (M.StatusAckMmc,), check, priority=priority)
