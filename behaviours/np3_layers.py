@@ -22,6 +22,7 @@ from typing import Any, Callable, Mapping
 from arachnae_proto.enums import MovCmd
 
 from behaviours import tuning as T
+from behaviours.geometry import DEFAULT_GEOMETRY
 from behaviours.subsumption import Clock, Network, Outputs, Plan, ReflexModule
 
 STOP, FORWARD, BACKWARD = MovCmd.STOP, MovCmd.FORWARD, MovCmd.BACKWARD
@@ -43,8 +44,9 @@ Trigger = Callable[[Mapping[str, Any], float], "Steps | None"]
 #   goal (x, y) | None           explore: frontier target   sound (seq, direction deg) APU/SDF event
 #   echoes ((x, y, seen_deg, arc_m), ...) obstacle points of the last seconds (sonar, IR, whiskers) at the DR
 #                                pose, seen at body angle seen_deg, somewhere within arc_m across the beam
+#   veto (seq, command)          the node's motion check refused the command the network chose: do this instead
 SENSORS = ("whisker", "ir", "ir_fault", "pit", "tilt", "battery_low", "leg_blocked", "sonar_ahead_m", "light",
-           "pose", "goal", "sound", "echoes")
+           "pose", "goal", "sound", "echoes", "veto")
 
 
 @dataclass(frozen=True)
@@ -89,7 +91,14 @@ class Tuning:
     light_weave_s: float = T.NP3_LIGHT_WEAVE_S
     light_detour_step_deg: float = T.NP3_LIGHT_DETOUR_STEP_DEG
     light_detour_hold_s: float = T.NP3_LIGHT_DETOUR_HOLD_S
+    light_flat_log: float = T.NP3_LIGHT_FLAT_LOG
     turn_rate_deg_s: float = T.NP3_DR_TURN_DEG_S   # turn on the spot (measured; nominal 20 deg per 0.8 s)
+    walk_speed_m_s: float = T.NP3_DR_SPEED_M_S
+    body_half_length_m: float = T.NP3_BODY_FRONT_M
+    body_half_width_m: float = DEFAULT_GEOMETRY.body_width / 2
+    guard_margin_m: float = T.NP3_GUARD_MARGIN_M
+    guard_horizon_s: float = T.NP3_GUARD_HORIZON_S
+    guard_hold_s: float = T.NP3_GUARD_HOLD_S
 
 
 def _seen(ir: Any) -> list[float | None]:
@@ -135,21 +144,49 @@ def contact_trigger(t: Tuning) -> Trigger:
 
 
 def pit_trigger(t: Tuning) -> Trigger:
-    """seed 1.2.2 (sole switch), MMC NO_GROUND: a foot found no ground -> back off, turn away."""
+    """seed 1.2.2 (sole switch), MMC NO_GROUND: a foot found no ground -> step away from that foot (back off
+    from a front foot, walk on from a rear one, sidestep from a middle one), then turn away from its side.
+    The register is (seq, foot x, foot y) in the body frame, or a bare count (a foot not known: back off)."""
     edge = _Edge()
-    return lambda i, now: [(t.pit_back_s, BACKWARD), (t.pit_turn_s, LEFT)] if edge.new(i.get("pit")) else None
+
+    def trigger(i: Mapping[str, Any], now: float) -> Steps | None:
+        pit = i.get("pit")
+        if not edge.new(pit):
+            return None
+        fx, fy = (pit[1], pit[2]) if isinstance(pit, tuple) else (1.0, 0.0)
+        turn = RIGHT if fy > 0 else LEFT
+        if abs(fx) < 0.05:                      # a middle foot: the pit is beside the body
+            return [(t.pit_back_s, SIDE_RIGHT if fy > 0 else SIDE_LEFT), (t.pit_turn_s, turn)]
+        return [(t.pit_back_s, BACKWARD if fx > 0 else FORWARD), (t.pit_turn_s, turn)]
+    return trigger
+
+
+def uphill(tilt: Any) -> tuple[float, float]:
+    """The ground's rise per metre in the body frame (forward, left) from the ISC's two axes (seed 3.2.14:
+    0 longitudinal, nose up positive; 1 transverse, left side up positive)."""
+    lon, tr = tilt or (0.0, 0.0)
+    return math.tan(math.radians(lon)), math.tan(math.radians(tr))
+
+
+def steepness_deg(tilt: Any) -> float:
+    """The slope's own inclination, whatever the heading: a slope met diagonally splits it between the axes."""
+    return math.degrees(math.atan(math.hypot(*uphill(tilt))))
 
 
 def tilt_trigger(t: Tuning) -> Trigger:
-    """seed 3.2.14, decision 8: dangerous inclination -> back off downhill, turn round."""
+    """seed 3.2.14, decision 8: dangerous inclination -> step straight downhill (back, forward or sideways,
+    whichever is closest to the fall line), then turn until the slope is behind."""
     def trigger(i: Mapping[str, Any], now: float) -> Steps | None:
-        tilt = i.get("tilt") or (0.0, 0.0)
-        if max(abs(a) for a in tilt) <= t.tilt_limit_deg:
+        if steepness_deg(i.get("tilt")) <= t.tilt_limit_deg:
             return None
-        lon, tr = tilt
-        if abs(tr) > abs(lon):                 # steep across the body: turn the downhill way, then on
-            return [(t.tilt_turn_s / 2, LEFT if tr > 0 else RIGHT)]
-        return [(t.tilt_back_s, BACKWARD if lon > 0 else FORWARD), (t.tilt_turn_s, LEFT)]
+        ux, uy = uphill(i.get("tilt"))
+        if abs(ux) >= abs(uy):
+            away = BACKWARD if ux > 0 else FORWARD
+        else:
+            away = SIDE_RIGHT if uy > 0 else SIDE_LEFT
+        down = math.degrees(math.atan2(-uy, -ux))          # the fall line, body frame (ccw positive)
+        turn = [(abs(down) / t.turn_rate_deg_s, LEFT if down > 0 else RIGHT)] if abs(down) > 20 else []
+        return [(t.tilt_back_s, away), *turn]
     return trigger
 
 
@@ -172,6 +209,104 @@ def stop_while(register: str) -> Trigger:
     return lambda i, now: [(T.NP3_PERIOD_S, STOP)] if i.get(register) else None
 
 
+class EventModule:
+    """A module that answers each new event on its one input with a timed plan, replacing a running one
+    (a newer event knows better); it emits only while the plan runs."""
+
+    outputs = ("move",)
+
+    def __init__(self, name: str, layer: str, port: str, t: Tuning) -> None:
+        self.name, self.layer, self.t, self.inputs = name, layer, t, (port,)
+        self.edge = _Edge()
+        self.plan: Plan | None = None
+
+    def answer(self, event: Any) -> Steps | None:
+        raise NotImplementedError
+
+    def step(self, inputs: Mapping[str, Any], now: float) -> Outputs:
+        event = inputs.get(self.inputs[0])
+        if event is not None and self.edge.new(event[0]):
+            steps = self.answer(event)
+            if steps:
+                self.plan = Plan(steps, now)
+        if self.plan is not None and self.plan.value(now) is None:
+            self.plan = None
+        return {"move": self.plan.value(now) if self.plan else None}
+
+
+class GuardModule(EventModule):
+    """seed 5.1.2: the node's motion check refused the command the network chose (it would bring the body
+    into something the sensors saw): do the safe alternative it found for guard_hold_s. Unlike the other
+    reflexes a new refusal replaces a running plan at once (the alternative itself was refused)."""
+
+    def __init__(self, t: Tuning) -> None:
+        super().__init__("guard", REFLEXES, "veto", t)
+
+    def answer(self, event: Any) -> Steps | None:
+        return [(self.t.guard_hold_s, event[1])]
+
+
+# --------------------------------------------------------------------------- the motion check (seed 5.1.2)
+def velocity(cmd: Any, t: Tuning) -> tuple[float, float, float]:
+    """Body-frame velocity (forward m/s, left m/s, counter-clockwise rad/s) a direction command gives."""
+    v, u, w = t.walk_speed_m_s, t.side_speed_m_s, math.radians(t.turn_rate_deg_s)
+    return {FORWARD: (v, 0.0, 0.0), BACKWARD: (-v, 0.0, 0.0), SIDE_LEFT: (0.0, u, 0.0), SIDE_RIGHT: (0.0, -u, 0.0),
+            LEFT: (0.0, 0.0, w), RIGHT: (0.0, 0.0, -w)}.get(cmd, (0.0, 0.0, 0.0))
+
+
+def body_gap(px: float, py: float, t: Tuning) -> float:
+    """Distance from a body-frame point to the body's outline (0 on or inside it)."""
+    dx, dy = abs(px) - t.body_half_length_m, abs(py) - t.body_half_width_m
+    return math.hypot(max(dx, 0.0), max(dy, 0.0))
+
+
+def closing_in(points: list[Point], cmd: Any, t: Tuning) -> float:
+    """How far (m) the body's outline comes into the guard margin of a point it moves towards, following
+    `cmd` for the guard horizon (0: the move is safe). Only points the motion brings closer count: a body
+    already near a wall may still move away from it, and the echo's arc across a sonar beam counts as solid."""
+    vx, vy, w = velocity(cmd, t)
+    if vx == vy == w == 0.0:
+        return 0.0
+    reach = math.hypot(t.body_half_length_m, t.body_half_width_m) + t.guard_margin_m \
+        + t.guard_horizon_s * max(abs(vx), abs(vy), abs(w) * t.body_half_length_m)
+    near: list[tuple[float, float]] = []
+    for bx, by, _seen, arc in points:
+        d = math.hypot(bx, by)
+        if d - arc > reach:
+            continue
+        if arc > 0 and d > 0:                       # the ends and middle of the arc across the beam
+            ux, uy = -by / d, bx / d
+            near += [(bx + k * arc * ux, by + k * arc * uy) for k in (-1.0, 0.0, 1.0)]
+        else:
+            near.append((bx, by))
+    worst = 0.0
+    steps = 10
+    for px, py in near:
+        d0 = body_gap(px, py, t)
+        for k in range(1, steps + 1):
+            s = t.guard_horizon_s * k / steps
+            a = -w * s                              # the point as the moved body sees it
+            qx, qy = px - vx * s, py - vy * s
+            rx, ry = qx * math.cos(a) - qy * math.sin(a), qx * math.sin(a) + qy * math.cos(a)
+            d = body_gap(rx, ry, t)
+            if d < t.guard_margin_m and d < d0 - 1e-3:
+                worst = max(worst, t.guard_margin_m - d)
+    return worst
+
+
+def safe_instead(points: list[Point], cmd: Any, t: Tuning) -> Any:
+    """The command to give instead of an unsafe `cmd`: the closest safe alternative (turn the other way,
+    turn towards the freer side, back off), STOP when nothing is safe."""
+    crowd = sum(1 if by > 0 else -1 for bx, by, _s, _a in points if abs(bx) < 0.4 and abs(by) < 0.4)
+    freer = (RIGHT, LEFT) if crowd > 0 else (LEFT, RIGHT)
+    options = {FORWARD: (*freer, BACKWARD), BACKWARD: freer, LEFT: (RIGHT, BACKWARD, FORWARD),
+               RIGHT: (LEFT, BACKWARD, FORWARD), SIDE_LEFT: (SIDE_RIGHT, *freer), SIDE_RIGHT: (SIDE_LEFT, *freer)}
+    for alt in options.get(cmd, ()):
+        if closing_in(points, alt, t) == 0.0:
+            return alt
+    return STOP
+
+
 # --------------------------------------------------------------------------- level 1: avoidance
 def avoid_trigger(t: Tuning) -> Trigger:
     """seed 5.1.2: an obstacle ahead (IR centre or side beam, or the sonar looking ahead) -> turn away from it."""
@@ -183,14 +318,20 @@ def avoid_trigger(t: Tuning) -> Trigger:
         near = ((centre is not None and centre < t.avoid_centre_m)
                 or any(d is not None and d < t.avoid_side_m for d in (left, right))
                 or (sonar is not None and sonar < t.avoid_sonar_m)
-                or clear_ahead(pts, t.avoid_half_width_m) < t.avoid_echo_m)   # the memory: legs' corridor
+                or clear_ahead(pts, t.avoid_half_width_m, t.body_half_length_m) < t.avoid_echo_m)   # legs' corridor
         if not near:
             return None
         if left is not None or right is not None:
             turn = RIGHT if (left or math.inf) < (right or math.inf) else LEFT
-        else:                                  # the side with less in front of it in the memory
-            crowd = [by for bx, by, _s, _a in pts if 0 < bx < 2 * t.avoid_echo_m and abs(by) < 3 * t.avoid_half_width_m]
-            turn = RIGHT if sum(1 if by > 0 else -1 for by in crowd) > 0 else LEFT
+        else:                                  # the side whose heading after the turn the memory shows clearer
+            turn_rad = math.radians(t.turn_rate_deg_s * t.avoid_turn_s)
+            ahead = {c: clear_ahead(rotated(pts, sign * turn_rad), t.avoid_half_width_m, t.body_half_length_m)
+                     for c, sign in ((LEFT, 1.0), (RIGHT, -1.0))}
+            if ahead[LEFT] != ahead[RIGHT]:
+                turn = LEFT if ahead[LEFT] > ahead[RIGHT] else RIGHT
+            else:                              # the side with less in front of it
+                crowd = [by for bx, by, _s, _a in pts if 0 < bx < 2 * t.avoid_echo_m and abs(by) < 3 * t.avoid_half_width_m]
+                turn = RIGHT if sum(1 if by > 0 else -1 for by in crowd) > 0 else LEFT
         return [(t.avoid_turn_s, turn)]
     return trigger
 
@@ -211,6 +352,12 @@ def body_frame(echoes: Any, pose: tuple[float, float, float]) -> list[Point]:
     return [((ex - x) * c + (ey - y) * s, -(ex - x) * s + (ey - y) * c, seen, arc) for ex, ey, seen, arc in echoes or ()]
 
 
+def rotated(points: list[Point], angle: float) -> list[Point]:
+    """Body-frame points as the body sees them after turning on the spot by `angle` (rad, counter-clockwise)."""
+    c, s = math.cos(angle), math.sin(angle)
+    return [(bx * c + by * s, -bx * s + by * c, seen, arc) for bx, by, seen, arc in points]
+
+
 def wall_beside(points: list[Point], reach_m: float = 0.8) -> tuple[float | None, float | None]:
     """(distance of the right-hand wall from the body centre, its angle to the heading in rad) from the echoes
     seen to the right (65..115 deg); the angle is a line fitted along the wall, None while too short."""
@@ -226,10 +373,12 @@ def wall_beside(points: list[Point], reach_m: float = 0.8) -> tuple[float | None
     return dist, math.atan(slope)       # > 0: the wall falls away to the right ahead
 
 
-def clear_ahead(points: list[Point], half_width_m: float) -> float:
+def clear_ahead(points: list[Point], half_width_m: float, beyond_m: float = 0.0) -> float:
     """Distance from the body centre to the nearest echo surely in the corridor the body (and legs) sweep
-    walking on: a sonar echo whose cone also reaches outside it (a side wall seen at a slant) does not count."""
-    return min((bx for bx, by, _seen, arc in points if bx > 0 and abs(by) + arc < half_width_m), default=math.inf)
+    walking on: a sonar echo whose cone also reaches outside it (a side wall seen at a slant) does not count,
+    nor does one less than `beyond_m` ahead of the centre (beside the body: walking on cannot meet it)."""
+    return min((bx for bx, by, _seen, arc in points if bx > beyond_m and abs(by) + arc < half_width_m),
+               default=math.inf)
 
 
 def light_gradient(samples: list[tuple[float, float, float]], min_spread: float,
@@ -386,6 +535,11 @@ class TaskModule:
             self.plan = None                          # the probe has done its job: head for the light now
         self.gradient = fit or self.gradient
 
+    def dark(self) -> bool:
+        """A full set of light samples that differ by less than light_flat_log: no gradient to follow."""
+        logs = [s[2] for s in self.samples]
+        return len(logs) >= self.t.light_samples and max(logs) - min(logs) < self.t.light_flat_log
+
     def _seek_light(self, i: Mapping[str, Any], now: float) -> MovCmd:
         return self._light(i, now, sign=1.0)
 
@@ -401,10 +555,15 @@ class TaskModule:
         fit over the latest samples never degenerates into a line (a failed fit
         keeps the last direction). Each leg's heading is the one nearest the
         target whose corridor the echo memory shows clear: an obstacle across
-        the way is walked round along its edge (bug-style, seed 5.1.2).
+        the way is walked round along its edge (bug-style, seed 5.1.2). Seeking
+        a light none of the samples shows (all within light_flat_log: a lamp
+        behind a wall), the robot explores its map (planned routes, seed 3.3.2)
+        until it does.
         """
         t = self.t
         pose = i.get("pose")
+        if sign > 0 and self.dark():
+            return self._explore(i, now)
         ir = _seen(i.get("ir"))
         if self.gradient is None or pose is None:
             if any(d is not None for d in ir):
@@ -448,26 +607,17 @@ class TaskModule:
         return bearing
 
 
-class OrientModule:
+class OrientModule(EventModule):
     """Task level: turn towards a sound event (seed 3.2.7 APU/SDF direction, body frame, ccw from forward)."""
 
-    inputs = ("sound",)
-    outputs = ("move",)
-
     def __init__(self, t: Tuning) -> None:
-        self.name, self.layer, self.t = "orient", TASK, t
-        self.edge = _Edge()
-        self.plan: Plan | None = None
+        super().__init__("orient", TASK, "sound", t)
 
-    def step(self, inputs: Mapping[str, Any], now: float) -> Outputs:
-        sound = inputs.get("sound")
-        if sound is not None and self.edge.new(sound[0]):
-            err = (sound[1] + 180) % 360 - 180          # -180..180, positive: to the left
-            if abs(err) > self.t.sound_min_deg:
-                self.plan = Plan([(abs(err) / self.t.turn_rate_deg_s, LEFT if err > 0 else RIGHT)], now)
-        if self.plan is not None and self.plan.value(now) is None:
-            self.plan = None
-        return {"move": self.plan.value(now) if self.plan else None}
+    def answer(self, event: Any) -> Steps | None:
+        err = (event[1] + 180) % 360 - 180          # -180..180, positive: to the left
+        if abs(err) <= self.t.sound_min_deg:
+            return None
+        return [(abs(err) / self.t.turn_rate_deg_s, LEFT if err > 0 else RIGHT)]
 
 
 # --------------------------------------------------------------------------- the network
@@ -486,6 +636,7 @@ def np3_network(clock: Clock, task: str = "forward", tuning: Tuning | None = Non
     avoid = ReflexModule("avoid", AVOIDANCE, ("ir", "sonar_ahead_m", "pose", "echoes"), avoid_trigger(t))    # seed 5.1.2
     task_module = TaskModule(task, t)
     orient = OrientModule(t)
+    reflexes.append(GuardModule(t))                                                        # seed 5.1.2: no collision
     for m in (task_module, orient, avoid, *reflexes):
         net.add(m)
     for m in net.modules.values():
@@ -500,5 +651,6 @@ def np3_network(clock: Clock, task: str = "forward", tuning: Tuning | None = Non
     return net
 
 
-__all__ = ["Tuning", "TaskModule", "OrientModule", "np3_network", "light_gradient", "heading_error", "SENSORS",
+__all__ = ["uphill", "steepness_deg", "Tuning", "TaskModule", "OrientModule", "np3_network", "light_gradient", "heading_error", "SENSORS",
+           "closing_in", "safe_instead", "body_frame",
            "REFLEXES", "AVOIDANCE", "TASK", "TASKS"]

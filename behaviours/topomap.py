@@ -21,6 +21,7 @@ Python (no numpy): a 10 m x 10 m room at 10 cm is 10^4 cells.
 """
 from __future__ import annotations
 
+import heapq
 import math
 from collections import deque
 from dataclasses import dataclass
@@ -78,6 +79,7 @@ class OccupancyGrid:
         self.logodds = [0.0] * (self.nx * self.ny)
         self.seen = bytearray(self.nx * self.ny)       # ever crossed by a beam: coverage only grows
         self.hit, self.miss, self.limit = 0.9, -0.4, 5.0
+        self.barriers: set[tuple[int, int]] = set()      # pit edges and refused slopes (mark_barrier): never cleared
 
     # -- coordinates ----------------------------------------------------------------
     def cell(self, x: float, y: float) -> tuple[int, int]:
@@ -100,9 +102,21 @@ class OccupancyGrid:
 
     # -- updates --------------------------------------------------------------------
     def _bump(self, i: int, j: int, delta: float) -> None:
+        if (i, j) in self.barriers:
+            return
         k = j * self.nx + i
         self.logodds[k] = max(-self.limit, min(self.limit, self.logodds[k] + delta))
         self.seen[k] = 1
+
+    def mark_barrier(self, x: float, y: float) -> None:
+        """A foot found no ground here (seed 1.2.2) or the ground rises too steeply (3.2.14): the cell is as
+        impassable as a wall, for good."""
+        i, j = self.cell(x, y)
+        if self.inside(i, j):
+            k = j * self.nx + i
+            self.logodds[k] = self.limit
+            self.seen[k] = 1
+            self.barriers.add((i, j))
 
     def mark_free(self, x: float, y: float, radius_m: float) -> None:
         """The robot stands here: the cells under its body are free (and seen)."""
@@ -201,6 +215,7 @@ class TopoMap:
         self.place_spacing_m = place_spacing_m
         self.room = list(room) if room else None
         self.path: list[tuple[float, float]] = []
+        self.plan: list[tuple[float, float]] = []       # the route the robot follows now (drawn on the picture)
         self.places: list[Place] = []
         self.edges: set[tuple[int, int]] = set()
         self.clearance: list[float] = []
@@ -296,6 +311,52 @@ class TopoMap:
                     todo.append(n)
         return seen
 
+    def route(self, start: tuple[float, float], goal: tuple[float, float]) -> list[tuple[float, float]] | None:
+        """seed 3.3.2: the shortest way over the places graph (A*) from `start` to `goal`, as waypoints ending
+        at `goal`; None when the map joins them by no passable edges.
+
+        Start and goal join the graph at the nearest places they reach in a straight passable line, else at
+        their nearest place (the robot may stand close to a wall, a frontier lies next to unknown space,
+        where the clearance is small by definition). Call rebuild() after new readings: the route is only
+        as good as the graph.
+        """
+        if not self.places:
+            return None
+
+        def entry(p: tuple[float, float]) -> list[Place]:
+            near = sorted(self.places, key=lambda q: math.dist(p, (q.x, q.y)))[:6]
+            return [q for q in near if self.passable(p, (q.x, q.y))] or near[:1]
+
+        starts, goals = entry(start), {q.id: q for q in entry(goal)}
+        if not starts or not goals:
+            return None
+        by_id = {q.id: q for q in self.places}
+        adj: dict[int, list[int]] = {q.id: [] for q in self.places}
+        for a, b in self.edges:
+            adj[a].append(b)
+            adj[b].append(a)
+
+        def h(q: Place) -> float:
+            return math.dist((q.x, q.y), goal)
+
+        best = {q.id: math.dist(start, (q.x, q.y)) for q in starts}
+        came: dict[int, int | None] = {q.id: None for q in starts}
+        todo = [(best[q.id] + h(q), q.id) for q in starts]
+        heapq.heapify(todo)
+        while todo:
+            _f, cur = heapq.heappop(todo)
+            if cur in goals:
+                ids = [cur]
+                while came[ids[-1]] is not None:
+                    ids.append(came[ids[-1]])  # type: ignore[arg-type]
+                return [(by_id[i].x, by_id[i].y) for i in reversed(ids)] + [goal]
+            for n in adj[cur]:
+                d = best[cur] + math.dist((by_id[cur].x, by_id[cur].y), (by_id[n].x, by_id[n].y))
+                if d < best.get(n, math.inf):
+                    best[n], came[n] = d, cur
+                    heapq.heappush(todo, (d + h(by_id[n]), n))
+        return None
+
     def coverage(self) -> float:
         """Share of the room polygon's cells that some beam has crossed or hit (0..1)."""
         if not self.room:
@@ -388,6 +449,11 @@ class TopoMap:
             draw.ellipse((cx - r, cy - r, cx + r, cy + r), fill=(220, 30, 30))
         if len(self.path) > 1:
             draw.line([px(*p) for p in self.path], fill=(230, 140, 0), width=2)
+        if self.plan:                                  # the route being followed, from the robot on
+            pts = [px(*p) for p in ([self.path[-1]] if self.path else []) + self.plan]
+            draw.line(pts, fill=(0, 170, 60), width=3)
+            (gx, gy), r = pts[-1], max(5, 2 * s)
+            draw.rectangle((gx - r, gy - r, gx + r, gy + r), outline=(0, 170, 60), width=2)
         out = Path(path)
         img.save(out, format="PNG")
         return out

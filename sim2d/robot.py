@@ -29,6 +29,7 @@ from sim2d.world import BODY, OBSTACLE, WALL, World
 CONTACT_EPS = 0.002   # a foot within 2 mm of the ground touches it
 DEPTH_EPS = 1e-6      # a swing foot moving this much further into a solid's footprint is blocked
 LEG_REACH = 0.45      # body centre to the farthest foot, with margin
+SLIDE_M = 0.005       # a foot lowered along a wall it touches may drift this far sideways per step
 
 
 @dataclass
@@ -213,9 +214,13 @@ class Robot:
                     # from the side (the foot was below the top before): it hits the obstacle;
                     # from above: it lands on top (contact below). A foot the body carried into a
                     # footprint while it was in the air is not stuck there: only a move that takes it
-                    # into the solid, or deeper, is stopped (it lifts or slides out)
+                    # into the solid, or deeper, is stopped (it lifts or slides out). A foot pressed
+                    # against a wall's face still slides down it: lowering (with at most SLIDE_M of
+                    # sideways drift) is not a hit, else it would hang there and report no ground
+                    sliding = fz < old_foot[2] and math.dist(leg.world, old_world) < SLIDE_M
                     if (solid.height > fz + CONTACT_EPS and old_foot[2] < solid.height - CONTACT_EPS
-                            and solid.depth > self.world.solid_at(*old_world).depth + DEPTH_EPS):
+                            and solid.depth > self.world.solid_at(*old_world).depth + DEPTH_EPS
+                            and not sliding):
                         # seed 6.1: the swing foot hits an obstacle; the servos stall
                         for j, a in zip(leg.joints, old):
                             j.angle, j.speed = a, 0.0

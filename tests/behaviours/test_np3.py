@@ -195,6 +195,25 @@ def test_seek_light_samples_while_probing_and_stops_the_probe_once_the_gradient_
     assert out["move"] in (MovCmd.TURN_LEFT, MovCmd.FORWARD)           # ... for the light (+y: turn left)
 
 
+@pytest.mark.parametrize("rise, steers_to_goal", [(0.0, True), (0.05, False)])
+def test_seek_light_explores_towards_the_planned_goal_while_no_sample_shows_a_light(rise, steers_to_goal):
+    """A lamp shaded by a wall: the samples read the same everywhere, so the task layer follows the map's
+    goal (a route to the nearest frontier) instead of a gradient that is not there; a real gradient wins."""
+    t = Tuning()
+    task = TaskModule("seek_light", t)
+    goal = (0.0, -3.0)                                    # to the right of a robot facing +x
+    now = 0.0
+    for seq in range(1, t.light_samples + 1):            # an L of samples; log lux rises along +x by `rise`/step
+        x, y = (0.3 * seq, 0.0) if seq <= 4 else (1.2, 0.3 * (seq - 4))
+        task.plan = None
+        out = task.step({"light": (seq, x, y, 1.0 + rise * seq), "pose": (x, y, 0.0), "goal": goal}, now)
+        now += 2.5
+    assert task.dark() == steers_to_goal
+    task.plan = None
+    out = task.step({"pose": (1.2, 1.2, 0.0), "goal": goal}, now)
+    assert (out["move"] == MovCmd.TURN_RIGHT) == steers_to_goal
+
+
 def test_seek_light_walks_round_an_obstacle_on_one_side():
     t = Tuning()
     task = TaskModule("seek_light", t)
@@ -271,3 +290,44 @@ def test_exploring_sets_a_goal_short_of_the_mapped_walls(spec):
     x, y, _th = rig.node.odo.pose
     assert goal is not None and math.hypot(goal[0] - x, goal[1] - y) > 0.3
     assert math.hypot(*goal) < 1.5 - 0.1                                     # inside the walls, short of them
+
+
+def test_the_motion_check_refuses_only_moves_that_close_in_on_an_echo():
+    from behaviours.np3_layers import closing_in, safe_instead
+    t = Tuning()
+    behind = [(-0.2, 0.0, 180.0, 0.0)]                     # 5 cm behind the rear edge
+    assert closing_in(behind, MovCmd.BACKWARD, t) > 0
+    assert closing_in(behind, MovCmd.FORWARD, t) == 0      # moving away from it is always allowed
+    corner = [(0.1, 0.13, 50.0, 0.0)]                       # 5 cm beside the front of the left flank
+    assert closing_in(corner, MovCmd.TURN_LEFT, t) > 0     # the corner swings into it
+    assert closing_in(corner, MovCmd.TURN_RIGHT, t) == 0
+    assert safe_instead(corner, MovCmd.TURN_LEFT, t) == MovCmd.TURN_RIGHT
+    boxed = [(0.2, 0.0, 0.0, 0.0), (-0.2, 0.0, 180.0, 0.0), (0.0, 0.11, 90.0, 0.0), (0.0, -0.11, -90.0, 0.0),
+             (0.17, 0.1, 30.0, 0.0), (0.17, -0.1, -30.0, 0.0)]
+    assert safe_instead(boxed, MovCmd.FORWARD, t) == MovCmd.STOP     # nothing is safe: stand still
+    far = [(1.5, 0.0, 0.0, 0.05)]
+    assert all(closing_in(far, c, t) == 0 for c in MovCmd)
+
+
+def test_a_refused_command_hands_the_actuator_to_the_guard_reflex(spec):
+    rig = np3(spec)
+    rig.run(1.0)
+    rig.inject(1.0, MCP, data("IRRC", quantizer(M.XmitDataIrrc, "center").raw(9.0), channel=1))   # 9 cm ahead
+    rig.run(1.5)
+    metrics = rig.node.debug_metrics()
+    assert command_at(rig, 1.5) != MovCmd.FORWARD
+    assert metrics["takeovers"].get("guard", 0) + metrics["takeovers"].get("avoid", 0) >= 1
+
+
+def test_a_pit_under_a_rear_foot_is_left_forwards_and_stays_on_the_map(spec):
+    rig = np3(spec)
+    rig.inject(1.0, MCP, data("MMC", int(MmcError.NO_GROUND), STATUS, channel=3))   # leg 3: rear left
+    rig.run(1.5)
+    assert command_at(rig, 1.5) == MovCmd.FORWARD and rig.node.takeovers.get("pit") == 1
+    rig.run(1.0 + T.NP3_PIT_BACK_S + 0.5)
+    assert command_at(rig, 1.0 + T.NP3_PIT_BACK_S + 0.5) == MovCmd.TURN_RIGHT      # away from the left side
+    g = rig.node.map.grid
+    assert len(g.barriers) == 1
+    (i, j), = g.barriers
+    g.mark_free(*g.centre(i, j), 0.3)                                               # walking there later ...
+    assert g.state(i, j) == 2                                                       # ... does not clear it

@@ -155,3 +155,50 @@ def test_png_has_the_grid_size_and_shows_walls_places_and_unknown(tmp_path, squa
     assert pixel(-0.35, 3.0) == (160, 160, 160)
     colours = {rgb.getpixel((u, v)) for u in range(img.size[0]) for v in range(img.size[1])}
     assert (0, 0, 0) in colours and (220, 30, 30) in colours and (255, 255, 255) in colours
+
+
+def test_a_route_goes_round_through_the_door_and_never_through_the_wall(tmp_path):
+    closed, _ = two_rooms(door=False)
+    start, goal = (2.0, 3.3), (6.0, 3.3)                         # the straight line runs into the wall
+    assert closed.route(start, goal) is None                      # no door: no way
+    opened, walls = two_rooms(door=True)
+    route = opened.route(start, goal)
+    assert route is not None and route[-1] == goal
+    legs = list(zip([start] + route, route))
+    for a, b in legs[1:-1]:                                        # between places: the robot fits all the way
+        assert opened.passable(a, b)
+    crossing = [(a, b) for a, b in legs if (a[0] < 4) != (b[0] < 4)]
+    assert crossing and all(1.5 < (a[1] + b[1]) / 2 < 2.5 for a, b in crossing)    # through the door (y 1.5..2.5)
+    opened.plan = route
+    out = opened.save_png(tmp_path / "plan.png")
+    img = Image.open(out).convert("RGB")
+    assert any(img.getpixel((x, y)) == (0, 170, 60) for x in range(img.width) for y in range(0, img.height, 2))
+
+
+def test_pits_found_are_barriers_and_the_route_takes_their_one_gap_then_replans_when_it_closes():
+    """seed 1.2.2 / 3.3.2: a line of pits across the room (cells a foot found no ground on) with one gap: the
+    route uses the gap; once pits are found in the gap too the map has changed and there is no way."""
+    m = new_map(ROOM_POLY)
+    for pose in POSES:
+        m.add_scan(scan(ROOM, *pose))
+
+    def pits(y0: float, y1: float) -> None:
+        for k in range(int((y1 - y0) / 0.05) + 1):
+            for x in (2.9, 3.0, 3.1):
+                m.grid.mark_barrier(x, y0 + 0.05 * k)
+
+    start, goal = (1.2, 1.5), (4.8, 1.5)
+    m.rebuild()
+    direct = m.route(start, goal)
+    assert direct is not None and max(p[1] for p in direct) < 3.0        # open room: nearly straight across
+    pits(0.0, 4.4)                                                        # the gap: y 4.4 .. 6 (the wall)
+    m.add_scan(scan(ROOM, 1.5, 1.5, 0))                                   # a new echo cannot clear a pit
+    m.rebuild()
+    around = m.route(start, goal)
+    assert around is not None
+    legs = list(zip([start] + around, around))
+    crossing = [(a, b) for a, b in legs if (a[0] < 3.0) != (b[0] < 3.0)]
+    assert crossing and all(min(a[1], b[1]) > 4.4 for a, b in crossing)  # through the gap only
+    pits(4.4, 6.0)                                                        # pits found in the gap too
+    m.rebuild()
+    assert m.route(start, goal) is None

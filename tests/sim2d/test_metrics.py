@@ -1,0 +1,45 @@
+"""The 5.2 reaction metric's definition (sim2d.metrics.reactions), case by case."""
+from __future__ import annotations
+
+import pytest
+
+from sim2d.metrics import reactions
+
+FWD, BACK, LEFT = 1, 2, 4
+
+
+def reaction_latencies(*args: object) -> list[float]:
+    return [r["latency_s"] for r in reactions(*args)]  # type: ignore[arg-type]
+
+
+def test_a_stimulus_is_answered_by_the_first_move_of_the_manoeuvre_it_started():
+    # the task's FORWARD at 3.1 happens to follow; the reaction is the MOVE after the manoeuvre began at 3.2
+    lat = reaction_latencies([(3.0, "whisker")], [(1.0, FWD), (3.1, FWD), (3.3, BACK)], [(3.2, 5.0)], 1.0, 10.0)
+    assert lat == [pytest.approx(0.3)]
+
+
+def test_a_stimulus_during_post_counts_from_the_start_of_navigation():
+    lat = reaction_latencies([(0.0, "ir"), (0.02, "whisker")], [(1.4, FWD), (1.7, BACK)], [(1.6, 3.0)], 1.3, 10.0)
+    assert lat == [pytest.approx(1.7 - 1.3)]          # both answered by one reaction
+
+
+def test_stimuli_while_a_manoeuvre_runs_are_already_being_handled():
+    stimuli = [(2.0, "whisker"), (2.5, "ir"), (3.9, "whisker")]
+    lat = reaction_latencies(stimuli, [(2.1, BACK), (3.0, LEFT)], [(2.05, 4.0)], 1.0, 10.0)
+    assert lat == [pytest.approx(0.1)]
+
+
+def test_a_stimulus_never_answered_fails_with_the_rest_of_the_run():
+    lat = reaction_latencies([(5.0, "whisker")], [(1.0, FWD)], [], 1.0, 9.0)
+    assert lat == [pytest.approx(4.0)]
+    assert reaction_latencies([(8.5, "whisker")], [(1.0, FWD)], [], 1.0, 9.0) == []   # the run ended too soon
+
+
+def test_nothing_counts_when_navigation_never_started():
+    assert reaction_latencies([(1.0, "whisker")], [(1.5, BACK)], [(1.2, 2.0)], None, 9.0) == []
+
+
+def test_each_reaction_record_names_its_stimulus_and_whether_it_was_answered():
+    recs = reactions([(3.0, "whisker"), (6.0, "ir")], [(3.3, BACK)], [(3.2, 5.0)], 1.0, 9.0)
+    assert [(r["kind"], r["stimulus_s"], r["move_s"], r["answered"]) for r in recs] == [
+        ("whisker", 3.0, 3.3, True), ("ir", 6.0, 9.0, False)]
