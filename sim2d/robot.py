@@ -209,13 +209,14 @@ class Robot:
                 wx, wy = leg.world
                 ground = self.world.ground_height(wx, wy)
                 if not was and moving and self.world.has_solids:
-                    solid = self.world.solid_at(wx, wy)
+                    hip = to_world(self.pose, *self.p.hip(leg.index))     # a wall is deeper the further from the hip
+                    solid = self.world.solid_at(wx, wy, hip)
                     # from the side (the foot was below the top before): it hits the obstacle;
                     # from above: it lands on top (contact below). A foot the body carried into a
                     # footprint while it was in the air is not stuck there: only a move that takes it
                     # into the solid, or deeper, is stopped (it lifts or slides out)
                     if (solid.height > fz + CONTACT_EPS and old_foot[2] < solid.height - CONTACT_EPS
-                            and solid.depth > self.world.solid_at(*old_world).depth + DEPTH_EPS):
+                            and solid.depth > self.world.solid_at(*old_world, hip).depth + DEPTH_EPS):
                         # seed 6.1: the swing foot hits an obstacle; the servos stall
                         for j, a in zip(leg.joints, old):
                             j.angle, j.speed = a, 0.0
