@@ -142,7 +142,9 @@ SPU_ALARM_IRRC_CM = 6.0       # SET_ALARM IRRC: an object closer than this (3.2.
 SPU_ALARM_ISC_DEG = (15, 15)  # SET_ALARM ISC per axis (longitudinal, transverse): tilt beyond this either way (3.2.14)
 SPU_ALARM_TSC_C = 50          # SET_ALARM TSC, every probe: hotter than this (3.2.15)
 SPU_ALARM_LSC_LX = 500.0      # SET_ALARM LSC: brighter than this (3.2.16)
-SPU_ALARM_PSC_V = 4.4         # SET_ALARM PSC: battery under-voltage below this, a quarter charge at rest (3.2.17)
+SPU_ALARM_PSC_V = 4.4         # SET_ALARM PSC: battery under-voltage below this, a quarter charge at rest (3.2.17);
+                              # the PSC sees the loaded voltage: walking, it trips at about 40 % (fault_battery:
+                              # open-circuit 4.515 V at the alarm, ~5 A through the battery's 0.05 ohm)
 
 # --- sensor controllers (seed 3.2.11-3.2.17; all CHOICE: the seed gives no figures)
 USRC_SPREAD_RAW = 8           # 3 sonar readings further apart than ~30 cm are suspect (3.2.11)

@@ -14,7 +14,8 @@ from pathlib import Path
 import pytest
 
 from behaviours.kinematics import ik
-from sim2d.robot import Robot
+from sim2d.report import key_metrics
+from sim2d.robot import BatteryLog, Robot
 from sim2d.robot_params import DEFAULT as P
 from sim2d.scenario import load_scenario
 from sim2d.sim import Simulation
@@ -38,6 +39,8 @@ def test_a_full_battery_raises_no_alarm(spec, name, seed, until):
     assert b["psc_alarms"] == 0 and b["battery_low"] is False
     assert b["emf_final_v"] > 4.9                      # the charge is there: it was never a low battery
     assert b["psc_level_min_v"] > 4.4                  # the level the PSC judged stayed above the limit
+    assert b["stall_longest_s"] < 1.0                  # the LCP relieves a stalled servo within the seed's ~1 s
+                                                       # reaction time (5.2); explore seed 2 held one for 1.38 s
 
 
 ROOM = "duration: 20\narena: {size: [6, 4]}\nrobot: {pose: [1, 2, 0]}\n"
@@ -84,3 +87,20 @@ def test_a_foot_behind_a_wall_withdraws_without_stalling(write):
         assert not r.legs[2].blocked, f"step {k + 1}: blocked"
     assert r.legs[2].world[1] == pytest.approx(2.17, abs=1e-3)
     assert max(j.current for j in r.legs[2].joints) < P.servo_stall_a
+
+
+def test_the_battery_log_counts_stalled_servos_and_their_longest_stall():
+    """How long servos stay stalled is what drags a full battery down (issue 18): servo-steps at stall current,
+    and the longest run of one servo (a servo that stops stalling starts again from nothing)."""
+    log = BatteryLog()
+    for stalled in ([(4, 1), (4, 2)], [(4, 1)], [], [(4, 2)]):
+        log.add(4.8, 3.0, stalled)
+    assert log.stall_steps == 4 and log.stall_run_max == 2 and log.stall_run == {(4, 2): 1}
+
+
+def test_the_report_lists_the_battery_and_the_psc_first():
+    """report.html's key figures read the `battery` section (they read a `battery_v` that no longer existed)."""
+    shown = dict(key_metrics({"battery": {"v_min": 4.381, "emf_final_v": 4.929, "psc_mean_min_v": 4.555,
+                                          "psc_level_min_v": 4.69, "psc_alarms": 0, "stall_longest_s": 0.42}}))
+    assert shown["battery lowest (under load)"] == "4.381 V" and shown["PSC level judged, lowest"] == "4.69 V"
+    assert shown["PSC alarms"] == "0" and shown["servo stall, longest"] == "0.42 s"
