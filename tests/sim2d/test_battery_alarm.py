@@ -17,6 +17,7 @@ from behaviours.kinematics import ik
 from sim2d.report import key_metrics
 from sim2d.robot import BatteryLog, Robot
 from sim2d.robot_params import DEFAULT as P
+from sim2d.runner import run
 from sim2d.scenario import load_scenario
 from sim2d.sim import Simulation
 from sim2d.world import World
@@ -41,6 +42,15 @@ def test_a_full_battery_raises_no_alarm(spec, name, seed, until):
     assert b["psc_level_min_v"] > 4.4                  # the level the PSC judged stayed above the limit
     assert b["stall_longest_s"] < 1.0                  # the LCP relieves a stalled servo within the seed's ~1 s
                                                        # reaction time (5.2); explore seed 2 held one for 1.38 s
+
+
+def test_a_battery_that_really_runs_down_still_stops_beeps_and_blinks(spec):
+    """The other half of issue 18: with the faster stall relief and the wall fix the true alarm still comes
+    (scenarios/fault_battery.yaml: 0.1 Ah at 70 %; its expectations say stop, beep, blink)."""
+    outcome = run(str(SCENARIOS / "fault_battery.yaml"), spec=spec)
+    assert not outcome.failed, outcome.failed
+    b = outcome.result.metrics["battery"]
+    assert b["psc_alarms"] == 1 and b["battery_low"] is True and b["psc_level_min_v"] < 4.4
 
 
 ROOM = "duration: 20\narena: {size: [6, 4]}\nrobot: {pose: [1, 2, 0]}\n"
