@@ -110,7 +110,6 @@ class LCP(PostMaster, Runtime, LcpSkeleton):
         self.measured: dict[int, float] = {}  # joint -> the angle (rad) its JAC last reported
         self.stall_start = -math.inf          # the leg's stall outside a swing: when it began, when last reported
         self.stall_seen = -math.inf
-        self.caught_at = -math.inf            # the last stall current any JAC reported, in any phase
         self.blocked_events = 0
         self.stall_holds = 0                  # feet stopped by stall current outside a swing
         self.run_post(self.post_done)
@@ -190,9 +189,7 @@ class LCP(PostMaster, Runtime, LcpSkeleton):
             # reach down for the ground before calling it a pit (a sole switch only sees touch)
             self.search_z = max(-T.LCP_GROUND_SEARCH_M, self.search_z - T.LCP_GROUND_SEARCH_M_S * period)
         elif (self.carrying() and t - max(self.touchdown, self.lost_contact) > T.LCP_SETTLE_S
-              and not self.flags & _NO_GROUND and t - self.caught_at > T.LCP_STALL_GAP_S):
-            # a foot its servos push against something at stall current is caught (on a wall's face), not over
-            # a pit: no ground under it is not news the MMC should back away from (issue 18)
+              and not self.flags & _NO_GROUND):
             self.flags |= _NO_GROUND          # seed 1.2.2: the sole finds no ground (a pit)
             self.hw.note("no_ground", leg=self.leg)
         x, y, z = seg.at(t + period) if seg is not None else self.pos
@@ -255,7 +252,6 @@ class LCP(PostMaster, Runtime, LcpSkeleton):
         seg = self.seg
         if fb.current < T.LCP_BLOCK_CURRENT_A * 1000:
             return
-        self.caught_at = self.now
         if seg is None or not seg.swing or seg.done(self.now):
             # issue 18: one JAC's clean reading does not end the leg's stall (its joints stall and slip by
             # turns against a wall); a whole round of polls without stall current does

@@ -215,21 +215,3 @@ def test_a_leg_stalling_and_slipping_by_turns_is_stopped_too(spec):
     stalled["on"] = False
     rig.run(3.0)
     _held_where_it_stuck(rig)
-
-
-def test_a_foot_caught_at_stall_current_is_not_over_a_pit(spec):
-    """Issue 18, fault_us_killed_explore seed 16: a foot set down against a wall's face hung there, its sole
-    open, so the LCP reported NO_GROUND and the NP3 backed away from a pit that was not there (into the wall
-    behind). While its servos report stall current the foot is caught; once they stop, no ground is a pit."""
-    stalled = {"on": False}
-    rig = _stuck_rig(spec, lambda n: stalled["on"])
-    rig.board.sole = False
-    rig.run(1.3)
-    stalled["on"] = True                                         # caught for less than the stall hold
-    rig.run(1.45)
-    stalled["on"] = False
-    rig.run(1.45 + T.LCP_STALL_GAP_S - 0.05)
-    assert not report(rig, rig.board.t).flags & LegFlags.NO_GROUND
-    assert rig.node.stall_holds == 0
-    rig.run(1.45 + T.LCP_STALL_GAP_S + 0.3)
-    assert report(rig, rig.board.t).flags & LegFlags.NO_GROUND
