@@ -15,7 +15,9 @@ processing, for speed):
   foot is set down where the swing began. BLOCKED clears after a clean swing.
   Stall current outside a swing (a foot set down, held or hovering against a
   wall) for LCP_STALL_HOLD_S: the foot stops where the JACs report it (servo
-  protection; the leg's flags are left to the swing's rule).
+  protection; the leg's flags are left to the swing's rule). The stall is the
+  leg's: any of its JACs reporting stall current, with gaps no longer than
+  LCP_STALL_GAP_S (a foot scraping a wall stalls and slips by turns).
 - a JAC that stops answering: LEG_FLAGS.JAC_FAULT, OUT_OF_ORDER.
 - a JAC reporting OVERTEMP: LEG_FLAGS.OVERTEMP (the MMC slows the gait).
 The sole switch is read locally (seed 1.2.2): a carrying foot without ground
@@ -106,7 +108,8 @@ class LCP(PostMaster, Runtime, LcpSkeleton):
         self.sent_at: dict[int, float] = {}
         self.servo_temp: dict[int, float] = {}
         self.measured: dict[int, float] = {}  # joint -> the angle (rad) its JAC last reported
-        self.stalled_since: dict[int, float] = {}   # JAC -> since when it draws stall current outside a swing
+        self.stall_start = -math.inf          # the leg's stall outside a swing: when it began, when last reported
+        self.stall_seen = -math.inf
         self.blocked_events = 0
         self.stall_holds = 0                  # feet stopped by stall current outside a swing
         self.run_post(self.post_done)
@@ -248,11 +251,14 @@ class LCP(PostMaster, Runtime, LcpSkeleton):
         self.flags = (self.flags | _OVERTEMP) if self.hot else (self.flags & ~_OVERTEMP)
         seg = self.seg
         if fb.current < T.LCP_BLOCK_CURRENT_A * 1000:
-            self.stalled_since.pop(src, None)
             return
         if seg is None or not seg.swing or seg.done(self.now):
-            since = self.stalled_since.setdefault(src, self.now)
-            if self.now - since >= T.LCP_STALL_HOLD_S:
+            # issue 18: one JAC's clean reading does not end the leg's stall (its joints stall and slip by
+            # turns against a wall); a whole round of polls without stall current does
+            if self.now - self.stall_seen > T.LCP_STALL_GAP_S:
+                self.stall_start = self.now
+            self.stall_seen = self.now
+            if self.now - self.stall_start >= T.LCP_STALL_HOLD_S:
                 self.halt_stalled()
             return
         if self.retried and self.now - seg.t0 < T.LCP_RETRY_GRACE_S:
@@ -284,7 +290,7 @@ class LCP(PostMaster, Runtime, LcpSkeleton):
         left pushing at stall current cooks its motor and drags the battery voltage under the PSC's alarm
         limit (issue 18). The next LEG_TARGET starts from here. No BLOCKED flag: that is the swing's rule
         (6.1), and a flag would make the NP3 step aside at every touch of a set-down foot."""
-        self.stalled_since.clear()
+        self.stall_start = self.stall_seen = -math.inf
         g = self.cfg.geometry
         q = list(ik(g, self.leg, *self.pos))  # a joint not polled yet: where it was sent
         for joint, angle in self.measured.items():

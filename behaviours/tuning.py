@@ -42,7 +42,9 @@ LCP_SPEED_MARGIN = 2.0        # commanded speed = this x the speed needed to arr
 LCP_RETRACT = 0.3             # seed 6.1: a blocked foot goes back this fraction towards its segment start
 LCP_RETRY_MIN_S = 0.2         # shortest retried swing after a block
 LCP_RETRY_GRACE_S = 0.15      # stall current this soon after the retract began is still the first block
-LCP_STALL_HOLD_S = 1.0        # a joint stalled this long outside a swing stops pushing (servo protection, issue 18)
+LCP_STALL_HOLD_S = 0.3        # a leg stalled this long outside a swing stops pushing (servo protection, issue 18);
+                              # 3 polls: long enough to pass a foot's moment of catching as it is set down
+LCP_STALL_GAP_S = 0.35        # ... a stall with no report of stall current for longer (a round of 3 JAC polls) is over
 LCP_RETRY_CLEARANCE_M = 0.01  # retried swing lifts this much above the step limit
 LCP_HIGH_STEPS = 3            # after a block the leg's next swings step that high too (the obstacle is still there)
 LCP_JAC_TIMEOUTS = 4          # this many JOINT_POLLs in a row unanswered (each with the bus's retry, asked again at
@@ -148,7 +150,9 @@ SPU_ALARM_IRRC_CM = 6.0       # SET_ALARM IRRC: an object closer than this (3.2.
 SPU_ALARM_ISC_DEG = (15, 15)  # SET_ALARM ISC per axis (longitudinal, transverse): tilt beyond this either way (3.2.14)
 SPU_ALARM_TSC_C = 50          # SET_ALARM TSC, every probe: hotter than this (3.2.15)
 SPU_ALARM_LSC_LX = 500.0      # SET_ALARM LSC: brighter than this (3.2.16)
-SPU_ALARM_PSC_V = 4.4         # SET_ALARM PSC: battery under-voltage below this, a quarter charge at rest (3.2.17)
+SPU_ALARM_PSC_V = 4.4         # SET_ALARM PSC: battery under-voltage below this, a quarter charge at rest (3.2.17);
+                              # the PSC sees the loaded voltage: walking, it trips at about 40 % (fault_battery:
+                              # open-circuit 4.515 V at the alarm, ~5 A through the battery's 0.05 ohm)
 
 # --- sensor controllers (seed 3.2.11-3.2.17; all CHOICE: the seed gives no figures)
 USRC_SPREAD_RAW = 8           # 3 sonar readings further apart than ~30 cm are suspect (3.2.11)

@@ -95,8 +95,9 @@ def node_metrics(nodes: dict[str, Any]) -> dict[str, Any]:
 
 def battery_metrics(robot: "Robot", nodes: dict[str, Any]) -> dict[str, Any]:
     """seed 3.2.17 at a glance (issue 18): the battery's terminal voltage over the run (min/mean/final, every
-    physics step), its open-circuit voltage at the end (the charge left), the current, and what the PSC made
-    of it: the mean it reports, its lowest, the lowest level it judged against the limit, its alarms."""
+    physics step), its open-circuit voltage at the end (the charge left), the current and how much of it was
+    servos stalled (servo-seconds, the longest run of one servo), and what the PSC made of it: the mean it
+    reports, its lowest, the lowest level it judged against the limit, its alarms."""
     log = robot.battery_log
     psc, mcp = nodes.get("PSC") or {}, nodes.get("MCP") or {}    # node_metrics: absent or dead nodes are missing
     return {
@@ -107,6 +108,8 @@ def battery_metrics(robot: "Robot", nodes: dict[str, Any]) -> dict[str, Any]:
         "charge_used_ah": round(robot.charge_used_ah, 4),
         "i_mean_a": round(log.i_sum / log.steps, 2) if log.steps else None,
         "i_max_a": round(log.i_max, 2),
+        "stall_servo_s": round(log.stall_steps * robot.p.dt, 2),     # servo-seconds at stall current
+        "stall_longest_s": round(log.stall_run_max * robot.p.dt, 2),  # the longest one servo stalled in a row
         "psc_mean_v": psc.get("mean_v"),
         "psc_mean_min_v": psc.get("mean_min_v"),
         "psc_level_min_v": psc.get("level_min_v"),
@@ -152,8 +155,8 @@ def metrics_schema(spec: Any, measured: Sequence[str] = ()) -> dict[str, Any]:
                                "collisions", "min_clearance_m", "blocked_leg_events", "pit_events", "fell",
                                "tilt_events", "max_tilt_deg", "reach_time_s", "entered_forbidden_s", "moves",
                                "reaction_latencies_s", "max_reaction_s", "frames", "frame_loss", "frames_corrupted")},
-        "battery": _leaves("v_min", "v_mean", "v_final", "emf_final_v", "i_mean_a", "i_max_a", "charge_used_ah",
-                           "psc_mean_v", "psc_mean_min_v", "psc_level_min_v", "psc_alarms", "battery_low"),
+        "battery": _leaves("v_min", "v_mean", "v_final", "emf_final_v", "i_mean_a", "i_max_a", "stall_servo_s",
+                           "stall_longest_s", "charge_used_ah", "psc_mean_v", "psc_mean_min_v", "psc_level_min_v", "psc_alarms", "battery_low"),
         "post": _obj({"verdict": {"enum": [*spec.post.verdicts, None]}, "missing": _VALUE, "reasons": _VALUE,
                       "time_s": _VALUE}),
         "buses": _obj({name: bus for name in spec.buses}),

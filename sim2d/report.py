@@ -207,7 +207,11 @@ KEY_METRICS = (
     ("least clearance", "min_clearance_m", "m"), ("pit events", "pit_events", ""), ("fell", "fell", ""),
     ("tilt events", "tilt_events", ""), ("largest tilt", "max_tilt_deg", "°"), ("goal reached at", "reach_time_s", "s"),
     ("MOVE commands", "moves", ""), ("slowest reaction", "max_reaction_s", "s"), ("frames", "frames", ""),
-    ("frames lost", "frame_loss", ""), ("frames corrupted", "frames_corrupted", ""), ("battery", "battery_v", "V"),
+    ("frames lost", "frame_loss", ""), ("frames corrupted", "frames_corrupted", ""),
+    # seed 3.2.17, issue 18: the battery under load, what the PSC judged against its limit, and the stalls behind a dip
+    ("battery lowest (under load)", "battery.v_min", "V"), ("battery open-circuit at the end", "battery.emf_final_v", "V"),
+    ("PSC mean, lowest", "battery.psc_mean_min_v", "V"), ("PSC level judged, lowest", "battery.psc_level_min_v", "V"),
+    ("PSC alarms", "battery.psc_alarms", ""), ("servo stall, longest", "battery.stall_longest_s", "s"),
 )
 
 

@@ -73,20 +73,26 @@ class Events:
 
 @dataclass
 class BatteryLog:
-    """The battery's terminal voltage and current at every physics step (issue 18: a load dip that the
-    PSC could take for under-voltage is visible in the metrics at a glance)."""
+    """The battery's terminal voltage and current at every physics step, and the servos drawing stall current
+    (issue 18: a load dip that the PSC could take for under-voltage, and what caused it, visible at a glance)."""
     v_min: float = math.inf
     v_sum: float = 0.0
     i_max: float = 0.0
     i_sum: float = 0.0
     steps: int = 0
+    stall_steps: int = 0                  # servo-steps at stall current
+    stall_run: dict[tuple[int, int], int] = field(default_factory=dict)   # (leg, joint) -> steps stalled in a row
+    stall_run_max: int = 0
 
-    def add(self, volts: float, amps: float) -> None:
+    def add(self, volts: float, amps: float, stalled: list[tuple[int, int]]) -> None:
         self.v_min = min(self.v_min, volts)
         self.v_sum += volts
         self.i_max = max(self.i_max, amps)
         self.i_sum += amps
         self.steps += 1
+        self.stall_steps += len(stalled)
+        self.stall_run = {k: self.stall_run.get(k, 0) + 1 for k in stalled}
+        self.stall_run_max = max(self.stall_run_max, max(self.stall_run.values(), default=0))
 
 
 def _ccw(pts: list[Pt]) -> list[Pt]:
@@ -210,7 +216,8 @@ class Robot:
                 wx, wy = leg.world
                 ground = self.world.ground_height(wx, wy)
                 if not was and moving and self.world.has_solids:
-                    solid = self.world.solid_at(wx, wy)
+                    hip = to_world(self.pose, *self.p.hip(leg.index))     # a wall is deeper the further from the hip
+                    solid = self.world.solid_at(wx, wy, hip)
                     # from the side (the foot was below the top before): it hits the obstacle;
                     # from above: it lands on top (contact below). A foot the body carried into a
                     # footprint while it was in the air is not stuck there: only a move that takes it
@@ -219,7 +226,7 @@ class Robot:
                     # sideways drift) is not a hit, else it would hang there and report no ground
                     sliding = fz < old_foot[2] and math.dist(leg.world, old_world) < SLIDE_M
                     if (solid.height > fz + CONTACT_EPS and old_foot[2] < solid.height - CONTACT_EPS
-                            and solid.depth > self.world.solid_at(*old_world).depth + DEPTH_EPS
+                            and solid.depth > self.world.solid_at(*old_world, hip).depth + DEPTH_EPS
                             and not sliding):
                         # seed 6.1: the swing foot hits an obstacle; the servos stall
                         for j, a in zip(leg.joints, old):
@@ -248,7 +255,9 @@ class Robot:
         self.warm_servos(dt)
         self.current = total_current
         self.charge_used_ah += total_current * dt / 3600.0
-        self.battery_log.add(self.battery_voltage(), total_current)
+        stalled = [(leg.index, k) for leg in self.legs.values() for k, j in enumerate(leg.joints, 1)
+                   if j.current >= p.servo_stall_a]
+        self.battery_log.add(self.battery_voltage(), total_current, stalled)
 
     def _move_body(self) -> None:
         stance = [leg for leg in self.legs.values() if leg.contact and leg.anchor is not None]

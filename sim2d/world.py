@@ -97,12 +97,30 @@ class World:
         """Height of whatever solid occupies (x, y): 0 for free ground, walls are tall."""
         return self.solid_at(x, y).height
 
-    def solid_at(self, x: float, y: float) -> SolidHit:
-        """The solid occupying (x, y): its height and how far (x, y) lies inside its footprint."""
+    def solid_at(self, x: float, y: float, seen_from: Pt | None = None) -> SolidHit:
+        """The solid occupying (x, y): its height and how far (x, y) lies inside its footprint.
+
+        A wall is a thin segment, so the distance into it alone cannot tell a point that went in from one that
+        came through: `seen_from` (a leg's hip) counts a wall's depth from that side, on through and past its
+        centre line. A foot whose move takes it deeper is stopped (sim2d.robot); without the side, a foot that
+        crossed the centre line got shallower, passed behind the wall and then stalled its servos on every move
+        back into the room (issue 18, explore seed 2)."""
         q = self.space.point_query_nearest((x, y), 0.0, SOLID)
-        if q is None:
-            return SolidHit(0.0, 0.0)
-        return SolidHit(self.heights.get(q.shape, 0.0), max(0.0, -q.distance))
+        hit = SolidHit(0.0, 0.0) if q is None else SolidHit(self.heights.get(q.shape, 0.0), max(0.0, -q.distance))
+        if seen_from is None:
+            return hit
+        for w in self.space.segment_query(seen_from, (x, y), 0.0, WALL_ONLY):
+            (ax, ay), (bx, by) = w.shape.a, w.shape.b
+            length = math.hypot(bx - ax, by - ay)
+            if length == 0.0:
+                continue
+            nx, ny = (ay - by) / length, (bx - ax) / length          # a unit normal of the wall's centre line
+            if (seen_from[0] - ax) * nx + (seen_from[1] - ay) * ny > 0:
+                nx, ny = -nx, -ny                                     # ... pointing away from `seen_from`
+            depth = WALL_RADIUS + (x - ax) * nx + (y - ay) * ny
+            if depth > hit.depth:
+                hit = SolidHit(self.heights.get(w.shape, WALL_HEIGHT), depth)
+        return hit
 
     def in_pit(self, x: float, y: float) -> bool:
         return any(point_in_polygon(x, y, p) for p in self.scenario.pits)

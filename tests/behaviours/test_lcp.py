@@ -157,24 +157,42 @@ def test_servo_overtemperature_is_reported_with_the_temperature(spec):
     assert not report(rig, 2.0).flags & LegFlags.OVERTEMP
 
 
-def test_a_foot_stalled_outside_a_swing_stops_where_it_is(spec):
-    """seed 3.2.10 / 6.1, issue 18: a foot set down or held against a wall stalls outside a swing. The LCP
-    used to keep pushing it there at stall current for good (the servos cooked, a full battery sagged under
-    the PSC's alarm limit); now it holds the foot where the JACs report it."""
-    hx, hy = G.hip(1)
-    stuck = (hx + 0.01, hy + 0.11, 0.02)                        # the foot caught 2 cm up on its way down
-    q = ik(G, 1, *stuck)
-    stalled = {"on": False}
+STUCK = (G.hip(1)[0] + 0.01, G.hip(1)[1] + 0.11, 0.02)          # a foot caught 2 cm up on its way down
+
+
+def _stuck_rig(spec, stalled) -> Rig:
+    """LCP(1) whose JACs report the foot at STUCK; `stalled(poll number)` says whether a poll reads stall current.
+    A HOLD target to x=40 mm, y=120 mm on the ground goes out at 1.0 s."""
+    q = ik(G, 1, *STUCK)
+    polls = {"n": 0}
 
     def respond(f):                                              # the servos report where the foot is
         if isinstance(f.message, M.JointPoll):
+            polls["n"] += 1
             angle = _FB_DEG.raw(math.degrees(q[JACS.index(f.dst)]))
-            current = 1800 if stalled["on"] else 50
+            current = 1800 if stalled(polls["n"]) else 50
             return [(f.dst, M.JointFeedback(angle=angle, speed=0, current=current, temperature=35, flags=0))]
         return jacs_answer(f)
     rig = Rig(spec, "LCP", LCP1, respond)
     rig.run(1.0)
     rig.inject(1.0, MMC, M.LegTarget.from_phys(phase=int(LegPhase.HOLD), x=40, y=120, z=0, duration=2000))
+    return rig
+
+
+def _held_where_it_stuck(rig: Rig) -> None:
+    _, last = commanded(rig)[-1]
+    assert fk(G, 1, *last) == pytest.approx(STUCK, abs=2e-3)    # held where it stuck, not pushed on to x=40 mm
+    assert sum(1 for _, e, _ in rig.board.notes if e == "stall_hold") == 1
+    assert rig.node.debug_metrics()["stall_holds"] == 1
+    assert not rig.node.seg.swing and rig.node.seg.done(rig.board.t)
+
+
+def test_a_foot_stalled_outside_a_swing_stops_where_it_is(spec):
+    """seed 3.2.10 / 6.1, issue 18: a foot set down or held against a wall stalls outside a swing. The LCP
+    used to keep pushing it there at stall current for good (the servos cooked, a full battery sagged under
+    the PSC's alarm limit); now it holds the foot where the JACs report it."""
+    stalled = {"on": False}
+    rig = _stuck_rig(spec, lambda n: stalled["on"])
     rig.run(1.3)
     stalled["on"] = True                                         # it runs into something: stall current
     rig.run(1.3 + T.LCP_STALL_HOLD_S / 2)
@@ -182,8 +200,18 @@ def test_a_foot_stalled_outside_a_swing_stops_where_it_is(spec):
     rig.run(1.4 + T.LCP_STALL_HOLD_S + 3 * T.LCP_CONTROL_S)      # every JAC polled again after the hold time
     stalled["on"] = False                                        # stopped: the servos draw holding current
     rig.run(3.0)
-    _, last = commanded(rig)[-1]
-    assert fk(G, 1, *last) == pytest.approx(stuck, abs=2e-3)    # held where it stuck, not pushed on to x=40 mm
-    assert sum(1 for _, e, _ in rig.board.notes if e == "stall_hold") == 1
-    assert rig.node.debug_metrics()["stall_holds"] == 1
-    assert not rig.node.seg.swing and rig.node.seg.done(rig.board.t)
+    _held_where_it_stuck(rig)
+
+
+def test_a_leg_stalling_and_slipping_by_turns_is_stopped_too(spec):
+    """Issue 18, explore seed 4: a foot scraping along a wall stalls and slips by turns, so every other poll
+    read a clean current. Each JAC's stall timer restarted at its clean reading and the leg pushed on at stall
+    current; the stall is the leg's, over until a whole round of polls reads clean."""
+    stalled = {"on": False}
+    rig = _stuck_rig(spec, lambda n: stalled["on"] and n % 2 == 0)
+    rig.run(1.3)
+    stalled["on"] = True
+    rig.run(1.3 + T.LCP_STALL_HOLD_S + 6 * T.LCP_CONTROL_S)
+    stalled["on"] = False
+    rig.run(3.0)
+    _held_where_it_stuck(rig)
