@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import pymunk
 
 from behaviours.kinematics import fk, ik
-from sim2d.geometry import Pt, convex_hull, inside_convex, rigid_fit, to_world
+from sim2d.geometry import WALL_RADIUS, Pt, convex_hull, inside_convex, rigid_fit, to_world
 from sim2d.robot_params import RobotParams
 from sim2d.world import BODY, OBSTACLE, WALL, World
 
@@ -224,7 +224,9 @@ class Robot:
                     # into the solid, or deeper, is stopped (it lifts or slides out). A foot pressed
                     # against a wall's face still slides down it: lowering (with at most SLIDE_M of
                     # sideways drift) is not a hit, else it would hang there and report no ground
-                    sliding = fz < old_foot[2] and math.dist(leg.world, old_world) < SLIDE_M
+                    # - but never past a wall's centre line (issue 18: behind it, it stalls on every move back)
+                    sliding = (fz < old_foot[2] and math.dist(leg.world, old_world) < SLIDE_M
+                               and solid.depth <= WALL_RADIUS)
                     if (solid.height > fz + CONTACT_EPS and old_foot[2] < solid.height - CONTACT_EPS
                             and solid.depth > self.world.solid_at(*old_world, hip).depth + DEPTH_EPS
                             and not sliding):
