@@ -135,3 +135,24 @@ def test_untimed_check_still_names_a_missing_retry(saved, tmp_path):
     assert p.returncode == 1 and "id_retry" in out["by_rule"] and "bound_K" not in out["by_rule"]
     assert "no reply to ID_REQ 1 of 2 to PSC" in out["first"]
     assert "request_slot" not in out["checked"] and "one_talker" not in out["checked"]
+
+
+@pytest.mark.parametrize("corrupt", [True, False])
+def test_a_move_relayed_resent_after_a_corrupt_echo_is_no_violation(saved, tmp_path, corrupt):
+    """seed 3.2.2: the MCP resends a frame whose echo came back corrupt (a collision); only a resend of a frame
+    that went out intact needs a STATUS_ACK_MMC showing the command not applied (protocol.move_retries)."""
+    table = rows(saved / "trace.tsv")
+
+    # (the second send may overlap a later frame: that is another rule's business, this test reads move_retries)
+    i = next(i for i, r in enumerate(table[1:], 1) if r[2] == "first" and r[6].startswith("MOVE_RELAYED"))
+    start, end = float(table[i][0]), float(table[i][1])
+    again = list(table[i])
+    again[0], again[1] = f"{end + 0.001:.6f}", f"{2 * end - start + 0.001:.6f}"
+    if corrupt:                                # the first send was heard corrupt, as in a collision
+        heard = bytearray(bytes.fromhex(table[i][7]))
+        heard[-1] ^= 0x01
+        table[i][6], table[i][7] = "<CHECKSUM: corrupted>", heard.hex()
+    table.insert(i + 1, again)
+    p = cli("trace", "check", str(write(tmp_path / "t.tsv", table)), "--json")
+    out = json.loads(p.stdout)
+    assert ("move_retries" in out["by_rule"]) is not corrupt, out
