@@ -102,7 +102,7 @@ class MCP(PostMaster, Runtime, McpSkeleton):
         """seed 6.3: POST can be started at any time from the UIC/RCP."""
         if self.post_missing is None:
             return                      # one is running
-        self.hw.note("post_requested", by=NODES[src][0] if src in NODES else src)
+        self.hw.note("post_requested", by=NODES[src].short if src in NODES else src)
         self.run_post(self.post_done)
 
     # --- seed 3.2.2 message scheduling: serve the first XMIT_REQ that got through, then the next ---
@@ -149,7 +149,7 @@ class MCP(PostMaster, Runtime, McpSkeleton):
         r = self.net.reflex_from(rec.source)
         if r is None or r.actor != self.address or not rec.value or rec.kind == _STATUS or self.halted:
             return
-        self.hw.note("reflex", source=NODES[rec.source][0] if rec.source in NODES else rec.source, command=r.command)
+        self.hw.note("reflex", source=NODES[rec.source].short if rec.source in NODES else rec.source, command=r.command)
         self.relay_move(rec.source, int(Direction[r.command]), 0, 1 + self.net.protocol.move_retries, PRIORITY_REFLEX)
 
     def relay_move(self, src: int, mov_cmd: int, param: int, attempts: int, priority: int = 0) -> None:
@@ -188,7 +188,7 @@ class MCP(PostMaster, Runtime, McpSkeleton):
 
     def supervise(self, rec: M.XmitRecord) -> None:
         """What a record passing through means for the operator or supervisor (6.2, 3.2.12, 3.2.17)."""
-        role = NODES[rec.source][1] if rec.source in NODES else ""
+        role = NODES[rec.source].role if rec.source in NODES else ""
         if rec.kind == _STATUS:
             self.counts["status_records"] += 1
             key = (rec.source, rec.channel)
@@ -242,7 +242,7 @@ class MCP(PostMaster, Runtime, McpSkeleton):
 
     def debug_metrics(self) -> dict:
         v = self.verdict
-        faults = {NODES[a][0]: value for (a, _ch), value in sorted(self.faults.items()) if a in NODES}
+        faults = {NODES[a].short: value for (a, _ch), value in sorted(self.faults.items()) if a in NODES}
         return {"verdict": v.verdict if v else None, "missing": ",".join(top_missing(v.missing)) if v else "",
                 "faults": faults,
                 "posts": self.post_runs, "halted": self.halted, "lcd_line0": self.lcd[0], "lcd_line1": self.lcd[1],

@@ -287,7 +287,7 @@ class NP3(Runtime, Np3Skeleton):
         if msg.address not in NODES:
             return
         self.records += 1
-        role, kind, ch, v = NODES[msg.address][1], msg.kind, msg.channel, msg.value
+        role, kind, ch, v = NODES[msg.address].role, msg.kind, msg.channel, msg.value
         urgent = True
         if role == "MMC" and kind == _STATUS:
             self.mmc_status(ch, v)

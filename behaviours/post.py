@@ -26,7 +26,7 @@ class Verdict:
 
 def behind(address: int) -> list[int]:
     """Every node reached only through `address` (decision 2): its bus's slaves, recursively."""
-    bus = NODES[address][3]
+    bus = NODES[address].masters
     out: list[int] = []
     if bus is not None:
         for a in slaves_of(bus):
@@ -43,9 +43,9 @@ def verdict(net: NetConfig, missing_addresses: list[int]) -> Verdict:
     in_quorum: set[int] = set()
     for q in net.quorums:
         units: dict[int, list[int]] = {}
-        for a, (_short, role, *_rest) in NODES.items():
+        for a, node in NODES.items():
             key = net.units.get(a, {}).get(q.unit_key)
-            if role in q.unit_roles and key is not None:
+            if node.role in q.unit_roles and key is not None:
                 units.setdefault(key, []).append(a)
                 in_quorum.add(a)
         complete = [k for k, members in units.items() if not missing.intersection(members)]
@@ -54,10 +54,11 @@ def verdict(net: NetConfig, missing_addresses: list[int]) -> Verdict:
         elif len(complete) < len(units):
             lost = sorted(set(units) - set(complete))
             degraded.append(f"{q.name}: {', '.join(str(k) for k in lost)} incomplete")
-    for a, (short, _role, _bus, _masters, required) in NODES.items():
+    for a, node in NODES.items():
         if a in missing and a not in in_quorum:
-            (halted if required else degraded).append(f"{short} missing ({'required' if required else 'optional'})")
-    names = tuple(sorted(NODES[a][0] for a in missing))
+            (halted if node.required else degraded).append(
+                f"{node.short} missing ({'required' if node.required else 'optional'})")
+    names = tuple(sorted(NODES[a].short for a in missing))
     if halted:
         return Verdict("HALTED", names, tuple(halted))
     if degraded:
@@ -99,7 +100,7 @@ class PostMaster:
                     lost(a)                                                # seed 6.3: declares itself inactive
 
             def on_ack(src: int, msg: M.Message, a: int = a) -> None:
-                if NODES[a][1] in M.StatusAckBusy.SENDERS:
+                if NODES[a].role in M.StatusAckBusy.SENDERS:
                     return                                                 # busy / free is no health status
                 self.request(a, M.StatusReq(), _STATUS_REPLIES, on_status, lambda a=a: lost(a), retries)  # type: ignore[attr-defined]
             self.request(a, M.IdReq(), (M.IdAck,), on_ack, lambda a=a: lost(a), retries)  # type: ignore[attr-defined]
@@ -117,7 +118,7 @@ class PostMaster:
             def on_report(src: int, msg: M.PostReport) -> None:
                 missing.extend(msg.missing)
             for a in slaves_of(self.master_bus):                          # type: ignore[attr-defined]
-                if NODES[a][3] is not None and a not in missing:
+                if NODES[a].masters is not None and a not in missing:
                     self.request(a, M.PostQuery(), (M.PostReport,), on_report, lambda a=a: lost(a), retries,  # type: ignore[attr-defined]
                                  self.net.protocol.post_report_timeout_s)  # type: ignore[attr-defined]
             self.when_idle(finish)                                         # type: ignore[attr-defined]

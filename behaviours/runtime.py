@@ -47,21 +47,21 @@ class BusTiming:
     __slots__ = ("bit_s", "char_s", "turnaround_s", "gap_s", "slot_s", "timeout_s", "id_retries")
 
     def __init__(self, bus: str) -> None:
-        _master, baud, bits, turnaround_us, idle_gap_chars, timeout_ms, retries = BUSES[bus]
-        self.bit_s = 1 / baud
-        self.char_s = bits / baud
-        self.turnaround_s = turnaround_us * 1e-6
+        b = BUSES[bus]
+        self.bit_s = 1 / b.baud
+        self.char_s = b.bits_per_char / b.baud
+        self.turnaround_s = b.turnaround_us * 1e-6
         # spec buses: the least idle time before any frame, the turnaround and the gap that delimits frames
-        self.gap_s = max(self.turnaround_s, idle_gap_chars * self.char_s)
+        self.gap_s = max(self.turnaround_s, b.idle_gap_chars * self.char_s)
         # spec arbitration.slot = request_frame: one request frame (no payload) plus the frame gap
         self.slot_s = OVERHEAD * self.char_s + self.gap_s
-        self.timeout_s = timeout_ms / 1000
-        self.id_retries = retries
+        self.timeout_s = b.response_timeout_ms / 1000
+        self.id_retries = b.id_retries
 
 
 def slaves_of(bus: str) -> list[int]:
     """Addresses of the nodes sitting on `bus` as slaves, ascending."""
-    return sorted(a for a, (_n, _r, on, _m, _req) in NODES.items() if on == bus)
+    return sorted(a for a, node in NODES.items() if node.bus == bus)
 
 
 class Request:
@@ -95,7 +95,7 @@ class Runtime:
     def __init__(self, address: int, transmit: Callable[[str, bytes], None], hw: Hardware, cfg: Config) -> None:
         super().__init__(address, transmit)  # type: ignore[call-arg]
         self.hw, self.cfg, self.net = hw, cfg, cfg.net
-        self.master_bus: str | None = NODES[address][3]
+        self.master_bus: str | None = NODES[address].masters
         self.links: dict[str, MasterLink] = {self.master_bus: MasterLink(self.master_bus)} if self.master_bus else {}
         self._slave_out: dict[str, deque[bytes]] = {}
         self._timings: dict[str, BusTiming] = {}
@@ -349,7 +349,7 @@ class Runtime:
         except CodecError:
             src = opcode = None
         if bus != self.master_bus:                   # a reply may follow the master's frame
-            self._after_master[bus] = src is None or src == ADDRESS_OF[BUSES[bus][0]]
+            self._after_master[bus] = src is None or src == ADDRESS_OF[BUSES[bus].master]
         if not self._scope_all(bus):
             return
         if opcode is None:

@@ -85,7 +85,7 @@ class _Sensor(Runtime):
     """What the sensor controllers share: the SPU as master, DATA_RDY announcements, SET_ALARM limits."""
 
     def start(self) -> None:
-        self.master = ADDRESS_OF[BUSES[NODES[self.address][2]][0]]   # the master of its bus
+        self.master = ADDRESS_OF[BUSES[NODES[self.address].bus].master]   # the master of its bus
         self.alarms: dict[int, AlarmLimit] = {}
         self.announced_at: float | None = None
         self.alarm_count = 0
@@ -278,7 +278,7 @@ class TPSC(Runtime, TpscSkeleton):
     def start(self) -> None:
         self.contact = 0
         self.latched = 0
-        self.master = ADDRESS_OF[BUSES[NODES[self.address][2]][0]]   # the master of its bus
+        self.master = ADDRESS_OF[BUSES[NODES[self.address].bus].master]   # the master of its bus
         reflex = self.net.reflex_from(self.address)
         self.min_interval = reflex.min_interval_s if reflex else 0.0
         self.requested_at: float | None = None

@@ -75,7 +75,7 @@ def alarm_setup() -> list[tuple[str, M.Message, list[tuple[int, AlarmLimit]]]]:
 
 class SPU(PostMaster, Runtime, SpuSkeleton):
     def start(self) -> None:
-        self.sensors = {NODES[a][1]: a for a in slaves_of(self.master_bus)}
+        self.sensors = {NODES[a].role: a for a in slaves_of(self.master_bus)}
         self.live: list[str] = []
         self.status: dict[str, int] = {}
         self.misses: dict[str, int] = {}
@@ -100,8 +100,8 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
 
     def post_status(self, a: int, msg: M.Message) -> None:
         """A sensor's STATUS_ACK during POST updates what the SPU knows of it."""
-        if a in NODES and NODES[a][1] in STATUS_OF:
-            self.set_status(NODES[a][1], msg.status)       # type: ignore[attr-defined]
+        if a in NODES and NODES[a].role in STATUS_OF:
+            self.set_status(NODES[a].role, msg.status)       # type: ignore[attr-defined]
 
     def post_done(self, missing: list[int]) -> None:
         self.posting = False
@@ -154,7 +154,7 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
             self.set_status(role, _OUT_OF_ORDER)
 
     def on_data_rdy(self, src: int, msg: M.DataRdy) -> None:
-        role = NODES[src][1]
+        role = NODES[src].role
         if role not in XMIT_DATA_OF or role not in self.live:
             return
         if role in self.free_run:

@@ -289,7 +289,7 @@ def _check_route(f: "object") -> None:
     elif f.dst not in NODES:
         raise UserError(f"decode: ADDRESS: destination 0x{f.dst:02X} is not a node address")
     sender, receiver = NODES[f.src], NODES.get(f.dst)
-    if sender[1] not in m.SENDERS:
-        raise UserError(f"decode: ROUTE: {m.NAME} from {sender[0]}, but only {', '.join(m.SENDERS)} send it")
-    if receiver is not None and receiver[1] not in m.RECEIVERS:
-        raise UserError(f"decode: ROUTE: {m.NAME} to {receiver[0]}, but only {', '.join(m.RECEIVERS)} receive it")
+    if sender.role not in m.SENDERS:
+        raise UserError(f"decode: ROUTE: {m.NAME} from {sender.short}, but only {', '.join(m.SENDERS)} send it")
+    if receiver is not None and receiver.role not in m.RECEIVERS:
+        raise UserError(f"decode: ROUTE: {m.NAME} to {receiver.short}, but only {', '.join(m.RECEIVERS)} receive it")

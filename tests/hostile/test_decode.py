@@ -45,7 +45,7 @@ def test_decode_accepts_what_the_spec_allows(cli, dst, src, own):
 
 def test_every_frame_of_a_run_passes_the_address_and_route_checks(tmp_path, spec):
     """No false alarm: what the simulated robot really sends (a 3 s run) decodes without a route error."""
-    from codegen.cli import _check_route
+    from captures.cli import _check_route
     from sim2d.scenario import load_scenario
     from sim2d.sim import Simulation
 

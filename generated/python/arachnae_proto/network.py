@@ -6,64 +6,85 @@ from arachnae_proto import SPEC_HASH as _PACKAGE_HASH
 if _PACKAGE_HASH != "e31c9693acffbae3ee38ef78b0041c98e3c6d93ab40c70a0705758bdb16965de":
     raise ImportError(f"{__name__} was generated from another spec than arachnae_proto ({_PACKAGE_HASH[:12]}); run `arachnae codegen`")
 
+from typing import NamedTuple, Optional
+
 BROADCAST = 0xFF  # seed 3.2.1: never a node address
 
-# address: (short name, role, bus it sits on, bus it masters, required)
+
+class NodeInfo(NamedTuple):
+    """One node of spec/nodes.yaml; read its fields by name."""
+    short: str                  # short name, e.g. "LCP(1)"
+    role: str
+    bus: Optional[str]          # the bus it is a slave on (None for the MCP)
+    masters: Optional[str]      # the bus it is master of
+    required: bool              # seed 3.2 / 6.3: the POST needs it
+
+
+class BusInfo(NamedTuple):
+    """One bus of spec/nodes.yaml (seed 3.2.1, docs/decisions.md D9-D10); read its fields by name."""
+    master: str                 # short name of its master
+    baud: int
+    bits_per_char: int
+    turnaround_us: float
+    idle_gap_chars: float
+    response_timeout_ms: float
+    id_retries: int
+
+
 NODES = {
-    0x01: ("MCP", "MCP", None, "first", True),
-    0x02: ("NP3", "NP3", "first", None, True),
-    0x03: ("MMC", "MMC", "first", "leg", True),
-    0x04: ("SPU", "SPU", "first", "sensor", True),
-    0x05: ("SSC", "SSC", "first", None, False),
-    0x06: ("APU/SDF", "APU_SDF", "first", None, False),
-    0x07: ("UIC/RCP", "UIC_RCP", "first", None, False),
-    0x08: ("RLC", "RLC", "first", None, False),
-    0x21: ("LCP(1)", "LCP", "leg", "joints1", True),
-    0x22: ("LCP(2)", "LCP", "leg", "joints2", True),
-    0x23: ("LCP(3)", "LCP", "leg", "joints3", True),
-    0x24: ("LCP(4)", "LCP", "leg", "joints4", True),
-    0x25: ("LCP(5)", "LCP", "leg", "joints5", True),
-    0x26: ("LCP(6)", "LCP", "leg", "joints6", True),
-    0x41: ("JAC(1,1)", "JAC", "joints1", None, True),
-    0x42: ("JAC(1,2)", "JAC", "joints1", None, True),
-    0x43: ("JAC(1,3)", "JAC", "joints1", None, True),
-    0x44: ("JAC(2,1)", "JAC", "joints2", None, True),
-    0x45: ("JAC(2,2)", "JAC", "joints2", None, True),
-    0x46: ("JAC(2,3)", "JAC", "joints2", None, True),
-    0x47: ("JAC(3,1)", "JAC", "joints3", None, True),
-    0x48: ("JAC(3,2)", "JAC", "joints3", None, True),
-    0x49: ("JAC(3,3)", "JAC", "joints3", None, True),
-    0x4A: ("JAC(4,1)", "JAC", "joints4", None, True),
-    0x4B: ("JAC(4,2)", "JAC", "joints4", None, True),
-    0x4C: ("JAC(4,3)", "JAC", "joints4", None, True),
-    0x4D: ("JAC(5,1)", "JAC", "joints5", None, True),
-    0x4E: ("JAC(5,2)", "JAC", "joints5", None, True),
-    0x4F: ("JAC(5,3)", "JAC", "joints5", None, True),
-    0x50: ("JAC(6,1)", "JAC", "joints6", None, True),
-    0x51: ("JAC(6,2)", "JAC", "joints6", None, True),
-    0x52: ("JAC(6,3)", "JAC", "joints6", None, True),
-    0x27: ("USRC", "USRC", "sensor", None, True),
-    0x28: ("TPSC", "TPSC", "sensor", None, True),
-    0x29: ("IRRC", "IRRC", "sensor", None, True),
-    0x2A: ("ISC", "ISC", "sensor", None, True),
-    0x2B: ("TSC", "TSC", "sensor", None, True),
-    0x2C: ("LSC", "LSC", "sensor", None, True),
-    0x2D: ("PSC", "PSC", "sensor", None, False),
+    0x01: NodeInfo("MCP", "MCP", None, "first", True),
+    0x02: NodeInfo("NP3", "NP3", "first", None, True),
+    0x03: NodeInfo("MMC", "MMC", "first", "leg", True),
+    0x04: NodeInfo("SPU", "SPU", "first", "sensor", True),
+    0x05: NodeInfo("SSC", "SSC", "first", None, False),
+    0x06: NodeInfo("APU/SDF", "APU_SDF", "first", None, False),
+    0x07: NodeInfo("UIC/RCP", "UIC_RCP", "first", None, False),
+    0x08: NodeInfo("RLC", "RLC", "first", None, False),
+    0x21: NodeInfo("LCP(1)", "LCP", "leg", "joints1", True),
+    0x22: NodeInfo("LCP(2)", "LCP", "leg", "joints2", True),
+    0x23: NodeInfo("LCP(3)", "LCP", "leg", "joints3", True),
+    0x24: NodeInfo("LCP(4)", "LCP", "leg", "joints4", True),
+    0x25: NodeInfo("LCP(5)", "LCP", "leg", "joints5", True),
+    0x26: NodeInfo("LCP(6)", "LCP", "leg", "joints6", True),
+    0x41: NodeInfo("JAC(1,1)", "JAC", "joints1", None, True),
+    0x42: NodeInfo("JAC(1,2)", "JAC", "joints1", None, True),
+    0x43: NodeInfo("JAC(1,3)", "JAC", "joints1", None, True),
+    0x44: NodeInfo("JAC(2,1)", "JAC", "joints2", None, True),
+    0x45: NodeInfo("JAC(2,2)", "JAC", "joints2", None, True),
+    0x46: NodeInfo("JAC(2,3)", "JAC", "joints2", None, True),
+    0x47: NodeInfo("JAC(3,1)", "JAC", "joints3", None, True),
+    0x48: NodeInfo("JAC(3,2)", "JAC", "joints3", None, True),
+    0x49: NodeInfo("JAC(3,3)", "JAC", "joints3", None, True),
+    0x4A: NodeInfo("JAC(4,1)", "JAC", "joints4", None, True),
+    0x4B: NodeInfo("JAC(4,2)", "JAC", "joints4", None, True),
+    0x4C: NodeInfo("JAC(4,3)", "JAC", "joints4", None, True),
+    0x4D: NodeInfo("JAC(5,1)", "JAC", "joints5", None, True),
+    0x4E: NodeInfo("JAC(5,2)", "JAC", "joints5", None, True),
+    0x4F: NodeInfo("JAC(5,3)", "JAC", "joints5", None, True),
+    0x50: NodeInfo("JAC(6,1)", "JAC", "joints6", None, True),
+    0x51: NodeInfo("JAC(6,2)", "JAC", "joints6", None, True),
+    0x52: NodeInfo("JAC(6,3)", "JAC", "joints6", None, True),
+    0x27: NodeInfo("USRC", "USRC", "sensor", None, True),
+    0x28: NodeInfo("TPSC", "TPSC", "sensor", None, True),
+    0x29: NodeInfo("IRRC", "IRRC", "sensor", None, True),
+    0x2A: NodeInfo("ISC", "ISC", "sensor", None, True),
+    0x2B: NodeInfo("TSC", "TSC", "sensor", None, True),
+    0x2C: NodeInfo("LSC", "LSC", "sensor", None, True),
+    0x2D: NodeInfo("PSC", "PSC", "sensor", None, False),
 }
 NODE_ADDRESSES = frozenset(NODES)
-ADDRESS_OF = {name: address for address, (name, *_rest) in NODES.items()}
+ADDRESS_OF = {node.short: address for address, node in NODES.items()}
 
-# bus: (master, baud, bits per char, turnaround us, idle gap chars, response timeout ms, ID retries)
 BUSES = {
-    "first": ("MCP", 9600, 10, 500, 3.5, 10, 1),
-    "leg": ("MMC", 19200, 10, 250, 3.5, 10, 1),
-    "sensor": ("SPU", 2400, 10, 1000, 1.5, 10, 1),
-    "joints1": ("LCP(1)", 19200, 10, 250, 3.5, 10, 1),
-    "joints2": ("LCP(2)", 19200, 10, 250, 3.5, 10, 1),
-    "joints3": ("LCP(3)", 19200, 10, 250, 3.5, 10, 1),
-    "joints4": ("LCP(4)", 19200, 10, 250, 3.5, 10, 1),
-    "joints5": ("LCP(5)", 19200, 10, 250, 3.5, 10, 1),
-    "joints6": ("LCP(6)", 19200, 10, 250, 3.5, 10, 1),
+    "first": BusInfo("MCP", 9600, 10, 500, 3.5, 10, 1),
+    "leg": BusInfo("MMC", 19200, 10, 250, 3.5, 10, 1),
+    "sensor": BusInfo("SPU", 2400, 10, 1000, 1.5, 10, 1),
+    "joints1": BusInfo("LCP(1)", 19200, 10, 250, 3.5, 10, 1),
+    "joints2": BusInfo("LCP(2)", 19200, 10, 250, 3.5, 10, 1),
+    "joints3": BusInfo("LCP(3)", 19200, 10, 250, 3.5, 10, 1),
+    "joints4": BusInfo("LCP(4)", 19200, 10, 250, 3.5, 10, 1),
+    "joints5": BusInfo("LCP(5)", 19200, 10, 250, 3.5, 10, 1),
+    "joints6": BusInfo("LCP(6)", 19200, 10, 250, 3.5, 10, 1),
 }
 
 # For each node, the bus on which it reaches each peer (decision 2: only master <-> slave).
@@ -115,4 +136,4 @@ def name_of(address: int) -> str:
     if address == BROADCAST:
         return "ALL"
     node = NODES.get(address)
-    return node[0] if node else f"0x{address:02X}"
+    return node.short if node else f"0x{address:02X}"

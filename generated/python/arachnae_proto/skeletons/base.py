@@ -36,7 +36,7 @@ class NodeSkeleton:
         if address not in self.ADDRESSES:
             raise ValueError(f"0x{address:02X} is not a {self.ROLE} address")
         self.address = address
-        self.name = NODES[address][0]
+        self.name = NODES[address].short
         self.transmit = transmit
         self.routes = ROUTES[address]
         self.buses = tuple(sorted(set(self.routes.values())))
