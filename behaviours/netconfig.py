@@ -57,7 +57,7 @@ class NetConfig:
     protocol: Protocol
     arbitration: dict[str, str]            # bus -> 'address_backoff' | 'polled' | 'seed'
     backoff_slots: int                     # spec arbitration.address_backoff: slots per rank step
-    backoff_scope: str                     # 'all' (every slave defers after a collision) | 'colliders'
+    backoff_scope: str | None              # 'all' | 'colliders' (who defers after a collision); None: no such rule
     requesters: dict[str, tuple[int, ...]]  # bus -> addresses of the slaves sending its request_message, in rank order
     request_opcodes: dict[str, int]        # bus -> opcode of its request_message (a window slot, not a pause)
     inactive_statuses: tuple[str, ...]     # seed 6.3: a node reporting one of these counts as missing
@@ -85,23 +85,22 @@ class NetConfig:
         p = spec.protocol
         if p.response_timeout_to not in _TIMEOUT_TO:
             raise ValueError(f"protocol.response_timeout_to {p.response_timeout_to!r} is not one of {_TIMEOUT_TO}")
-        backoff = spec.arbitration.get("address_backoff", {})
+        backoff = spec.arbitration.get("address_backoff")
         if backoff and (backoff.get("slot") != _BACKOFF_SLOT or backoff.get("rank_order") not in _BACKOFF_ORDERS):
             raise ValueError(f"arbitration.address_backoff: only slot {_BACKOFF_SLOT} ordered by one of {_BACKOFF_ORDERS} "
                              f"is implemented")
-        scope = backoff.get("backoff_scope", "colliders")
-        if scope not in ("all", "colliders"):
-            raise ValueError(f"arbitration.address_backoff.backoff_scope {scope!r} is not 'all' or 'colliders'")
+        # spec arbitration (codegen.model.ARBITRATION_DEFAULTS fills what a rule leaves out)
+        scope = backoff["backoff_scope"] if backoff else None
         return cls(
             protocol=Protocol(p.response_timeout_to, int(p.master_defer_slots), p.post_report_timeout_ms / 1000,
                               int(p.move_retries), p.setpoint_refresh_ms / 1000),
             arbitration={name: b.arbitration for name, b in spec.buses.items()},
-            backoff_slots=int(backoff.get("backoff_slots", 1)), backoff_scope=scope,
+            backoff_slots=int(backoff["backoff_slots"]) if backoff else 0, backoff_scope=scope,
             requesters={name: tuple(n.address for n in spec.requesters(name))
                         for name, b in spec.buses.items() if b.request_message},
             reflexes=tuple(Reflex(spec.node(r.source).address, spec.node(r.actor).address, spec.node(r.to).address,
                                   r.command, r.min_interval_ms / 1000) for r in spec.reflexes),
-            reflex_lead_bits=int(backoff.get("reflex_lead_bits", 0)),
+            reflex_lead_bits=int(backoff["reflex_lead_bits"]) if backoff else 0,
             request_opcodes={name: spec.message(b.request_message).opcode
                              for name, b in spec.buses.items() if b.request_message},
             inactive_statuses=tuple(spec.post.inactive_statuses),

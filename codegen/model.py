@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from functools import cached_property
 from pathlib import Path
-from typing import Iterator
+from typing import Any, Iterator
 
 from codegen.encoding import MILLI, Encoding, Linear, Log10, to_fraction
 
@@ -403,7 +403,7 @@ class Spec:
             return []
         senders = set(self.message(b.request_message).senders)
         nodes = sorted((n for n in self.nodes if n.bus == bus and n.role in senders), key=lambda n: n.address)
-        order = self.arbitration.get(b.arbitration, {}).get("rank_order", "ascending_address")
+        order = self.arbitration.get(b.arbitration, ARBITRATION_DEFAULTS)["rank_order"]
         if order == "descending_address":
             return nodes[::-1]
         if order == "declared_priority":
@@ -478,6 +478,20 @@ def _bits_of(f: dict) -> int:
     return 8 if f["type"] in ("node", "char") else int(f.get("bits", 8))
 
 
+# What an arbitration rule means when it leaves a parameter out (seed 3.2.2's plain rule: the colliders
+# resend, ranks by address, no reflex lead). The one place these defaults live: the runtime
+# (behaviours.netconfig), the models (model_check.spec_adapter) and the docs read the filled-in rule.
+ARBITRATION_DEFAULTS: dict[str, Any] = {"rank_order": "ascending_address", "backoff_slots": 1,
+                                        "backoff_scope": "colliders", "reflex_lead_bits": 0,
+                                        "max_collisions_per_request": 0}
+
+
+def arbitration_rules(doc: dict) -> dict[str, dict]:
+    """nodes.yaml `arbitration`, each contention rule with ARBITRATION_DEFAULTS filled in (`polled` has none:
+    its slaves never contend)."""
+    return {name: dict(rule) if name == "polled" else {**ARBITRATION_DEFAULTS, **rule} for name, rule in doc.items()}
+
+
 def build(nodes_doc: dict, messages_doc: dict, sources: tuple[Path, ...], digest: str) -> Spec:
     """Build the model from documents that already passed schema and lint."""
     nodes = tuple(
@@ -521,7 +535,7 @@ def build(nodes_doc: dict, messages_doc: dict, sources: tuple[Path, ...], digest
     p = nodes_doc["protocol"]
     protocol = Protocol(p["response_timeout_to"], p["master_defer_slots"], p["post_report_timeout_ms"],
                         p["move_retries"], p["setpoint_refresh_ms"], p["section"])
-    return Spec(nodes=nodes, buses=buses, arbitration=dict(nodes_doc["arbitration"]), protocol=protocol, post=post, frame=frame,
+    return Spec(nodes=nodes, buses=buses, arbitration=arbitration_rules(nodes_doc["arbitration"]), protocol=protocol, post=post, frame=frame,
                 enums=enums, flags=flags, messages=messages, broadcast=nodes_doc["address"]["broadcast"],
                 level_bits=nodes_doc["address"]["level_bits"], sources=sources, hash=digest,
                 reflexes=tuple(Reflex(r["name"], r["source"], r["actor"], r["to"], r["message"], r["command"],

@@ -155,15 +155,6 @@ def record_route(spec, bus: str, slave) -> tuple[list[str], list[str], str]:
     return fetch, relay, target
 
 
-def backoff_scope(rule: dict) -> str:
-    """Adapter: who defers after a collision (spec lacks arbitration.<rule>.backoff_scope; the
-    rule text says the slave that read a corrupt echo, i.e. 'colliders')."""
-    scope = rule.get("backoff_scope", "colliders")
-    if scope not in ("colliders", "all"):
-        raise UserError(f"arbitration backoff_scope must be 'colliders' or 'all', not {scope!r}")
-    return scope
-
-
 def arbitration(spec, bus: str, scope: str | None = None) -> ArbParams:
     if bus not in spec.buses:
         raise UserError(f"unknown bus {bus!r}; buses: {', '.join(spec.buses)}")
@@ -180,9 +171,8 @@ def arbitration(spec, bus: str, scope: str | None = None) -> ArbParams:
         slaves.append(ArbSlave(n.short, rank, slots(sum(frame_us(spec, bus, f) for f in fetch), slot_us),
                                slots(sum(frame_us(spec, bus, f) for f in relay), slot_us) if relay else 0, target))
     return ArbParams(bus=bus, master=b.master, request=req, slot_us=slot_us, slaves=slaves,
-                     backoff_slots=int(rule.get("backoff_slots", 1)),
-                     max_collisions=int(rule.get("max_collisions_per_request", 0)),
-                     rule_section=rule.get("section", "3.2.2"), scope=scope or backoff_scope(rule))
+                     backoff_slots=int(rule["backoff_slots"]), max_collisions=int(rule["max_collisions_per_request"]),
+                     rule_section=rule.get("section", "3.2.2"), scope=scope or rule["backoff_scope"])
 
 
 # -- identification -------------------------------------------------------------------
