@@ -177,7 +177,7 @@ def _fault_problem(f: dict, bus_of: dict[str, str | None]) -> str | None:
     return None
 
 
-def _schema(spec: Any) -> dict[str, Any]:
+def scenario_schema(spec: Any) -> dict[str, Any]:
     """sim2d/scenario.schema.yaml, with the spec's node and bus names when a spec is given."""
     schema = copy.deepcopy(_SCHEMA)
     if spec is not None:
@@ -204,7 +204,7 @@ def _read(path: Path, shown: str) -> LDict:
     return doc
 
 
-def _gather(path: Path, shown: str, stack: tuple[Path, ...], merged: LDict) -> None:
+def gather_includes(path: Path, shown: str, stack: tuple[Path, ...], merged: LDict) -> None:
     """Merge one file into `merged`: its includes first, then its own keys (lists concatenate,
     mappings merge key by key, anything else: the later file wins). Every entry keeps its file and line."""
     doc = _read(path, shown)
@@ -218,7 +218,7 @@ def _gather(path: Path, shown: str, stack: tuple[Path, ...], merged: LDict) -> N
             raise locate(doc, where_, f"include cycle through {inc}")
         if not target.is_file():
             raise locate(doc, where_, f"included file {inc!r} not found")
-        _gather(target, str(Path(shown).parent / inc), stack + (target,), merged)
+        gather_includes(target, str(Path(shown).parent / inc), stack + (target,), merged)
     for key, value in doc.items():
         if key == "include":
             continue
@@ -265,8 +265,8 @@ def load_scenario(path: str | Path, spec: Any = None) -> Scenario:
     shown = str(path)
     p = Path(path).resolve()
     doc = new_dict(shown, 1)
-    _gather(p, shown, (p,), doc)
-    schema = _schema(spec)
+    gather_includes(p, shown, (p,), doc)
+    schema = scenario_schema(spec)
     check_schema(doc, schema)
     fill_defaults(doc, schema)
     _check_meaning(doc, spec)

@@ -38,9 +38,8 @@ from arachnae.errors import UserError, located
 from arachnae.validation import check_schema, fill_defaults
 from arachnae.yamlio import LDict, load_yaml, locate, new_dict
 from sim2d.metrics import lookup, metric_path_problem, metrics_schema
-# _gather, _schema: the scenario loader's own include merge and spec names (one place for both)
-from sim2d.scenario import _gather, load_scenario, safe_name
-from sim2d.scenario import _schema as scenario_schema
+# the scenario loader's own include merge and schema with the spec's names (one place for both)
+from sim2d.scenario import gather_includes, load_scenario, safe_name, scenario_schema
 
 _SCHEMA: dict[str, Any] = yaml.safe_load(Path(__file__).with_name("sweep.schema.yaml").read_text())
 PARAMS: tuple[str, ...] = tuple(_SCHEMA["properties"]["grid"]["properties"])
@@ -239,7 +238,7 @@ def plan(sweep: Sweep, spec: Any, staging: Path) -> Plan:
     for run in sweep.runs:
         if run.base_path not in bases:
             merged = new_dict(run.base, 1)
-            _gather(run.base_path, run.base, (run.base_path,), merged)
+            gather_includes(run.base_path, run.base, (run.base_path,), merged)
             bases[run.base_path] = _plain(merged)
         doc = apply_overrides(bases[run.base_path], run)
         head = (f"# {sweep.name} run {run.run_id}: {run.base} seed {run.seed}"
