@@ -143,3 +143,42 @@ def test_bad_sweep_file_is_one_line_with_file_and_line(folder: Path, text: str, 
     assert err.count("\n") == 1 and err.startswith(f"{bad}:{line}: "), err
     assert message in err
     assert not out.exists()                  # nothing half-written
+
+
+def test_a_killed_worker_loses_no_run_and_duplicates_none(folder: Path, two_workers: Path, spec) -> None:
+    """Issue 14.4: a worker process dies (SIGKILL) while the sweep runs on a real 2-worker cluster: Dask runs its
+    task again elsewhere, and the table holds every run once, equal to the undisturbed sweep's."""
+    import os
+    import signal
+    import threading
+    import time
+
+    from distributed import Client, LocalCluster
+
+    s = sw.load_sweep(folder / "sweep.yaml", spec)
+    out = folder / "killed"
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
+    try:
+        client = Client(cluster)
+        pids = client.run(os.getpid)                 # worker address -> its process
+        result: dict[str, sw.SweepResult] = {}
+        runner = threading.Thread(target=lambda: result.update(r=sw.execute(s, spec, out, scheduler=cluster.scheduler_address,
+                                                                            progress=False)))
+        runner.start()
+        deadline = time.monotonic() + 300
+        while not list((out / "rows").glob("*.json")) if (out / "rows").exists() else True:
+            assert time.monotonic() < deadline and runner.is_alive(), "no run finished"
+            time.sleep(0.05)
+        victim = sorted(pids.values())[0]
+        os.kill(victim, signal.SIGKILL)              # mid-sweep
+        finished_at_kill = len(list((out / "rows").glob("*.json")))
+        runner.join(timeout=600)
+        assert not runner.is_alive()
+        client.close()
+    finally:
+        cluster.close()
+    res = result["r"]
+    assert finished_at_kill < 4 and (res.runs, res.ran) == (4, 4)
+    rows = [json.loads(p.read_text())["run_id"] for p in sorted((out / "rows").glob("*.json"))]
+    assert rows == ["r000000", "r000001", "r000002", "r000003"]
+    assert _table(out) == _table(two_workers)
