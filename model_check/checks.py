@@ -114,7 +114,7 @@ def text(res: Result) -> str:
     elif not meets_deadline(res):
         lines.append("  BOUND EXCEEDED")
     elif not res.proof:
-        lines.append("  NO VIOLATION FOUND (bitstate search: NOT a proof, see the estimate above)")
+        lines.append("  NO VIOLATION FOUND (bitstate / hash-compact search: NOT a proof, see the estimate above)")
     elif m.responses and not res.bounds:
         lines.append("  SAFETY PROPERTIES HOLD (responses not checked)")
     else:
@@ -140,6 +140,9 @@ def run_check(args) -> int:
         if getattr(args, "bitstate", None):
             from model_check.bitstate import explore_bitstate
             res, _ = explore_bitstate(model, args.bitstate, progress=not args.quiet)
+        elif getattr(args, "hash_compact", None):
+            from model_check.bitstate import explore_hash_compact
+            res, _ = explore_hash_compact(model, args.hash_compact, progress=not args.quiet)
         elif getattr(args, "workers", 1) > 1:
             from model_check.parallel import explore_parallel
             res = explore_parallel(model, args.workers, progress=not args.quiet)

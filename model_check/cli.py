@@ -33,6 +33,9 @@ def register(sub) -> None:
     c.add_argument("--bitstate", type=_bits, default=None, metavar="BITS",
                    help="bitstate search in 2^BITS bits of memory (%d..%d), safety only; prints the expected "
                         "omissions: a pass is then NOT a proof" % (BITSTATE_MIN, BITSTATE_MAX))
+    c.add_argument("--hash-compact", type=_signature_bits, default=None, metavar="BITS",
+                   help="store a BITS-bit signature per state instead of the state (%d..%d), safety only; prints "
+                        "the expected omissions: a pass is then NOT a proof" % (COMPACT_MIN, COMPACT_MAX))
     c.set_defaults(func=_check)
     t = sub.add_parser("timing", help="worst-case POST, whisker-to-STOP and scan times from the spec")
     t.add_argument("--scope", choices=("colliders", "all"), default=None, help="override the backoff scope")
@@ -48,6 +51,16 @@ def _bits(text: str) -> int:
     value = _positive(text)
     if not BITSTATE_MIN <= value <= BITSTATE_MAX:
         raise argparse.ArgumentTypeError(f"must be {BITSTATE_MIN} .. {BITSTATE_MAX}: {value}")
+    return value
+
+
+COMPACT_MIN, COMPACT_MAX = 16, 64          # signature bits of --hash-compact
+
+
+def _signature_bits(text: str) -> int:
+    value = _positive(text)
+    if not COMPACT_MIN <= value <= COMPACT_MAX:
+        raise argparse.ArgumentTypeError(f"must be {COMPACT_MIN} .. {COMPACT_MAX}: {value}")
     return value
 
 
@@ -132,8 +145,10 @@ def _check(args) -> int:
     _check_options(args, spec)
     if args.promela:
         _check_promela_dir(args.promela)
-    if args.workers > 1 and args.bitstate:
-        raise UserError("--workers and --bitstate: choose one (the bitstate search runs on one process)")
+    modes = [flag for flag, on in (("--workers", args.workers > 1), ("--bitstate", args.bitstate),
+                                   ("--hash-compact", args.hash_compact)) if on]
+    if len(modes) > 1:
+        raise UserError(f"{' and '.join(modes)}: choose one search mode")
     try:
         return run_check(args)
     except OSError as exc:                  # e.g. the --promela folder filled up or vanished mid-run

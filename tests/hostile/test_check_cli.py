@@ -25,6 +25,8 @@ CASES = [
     ("unknown bus", ["arbitration", "--bus", "nope"], "--bus nope: unknown bus"),
     ("polled bus", ["arbitration", "--bus", "leg"], "polled"),
     ("unknown model", ["nonsense"], "unknown model 'nonsense'"),
+    ("hash-compact too narrow", ["id_retry", "--hash-compact", "8"], "must be 16 .. 64: 8"),
+    ("two search modes", ["id_retry", "--bitstate", "20", "--hash-compact", "32"], "choose one search mode"),
     ("promela folder missing", ["post", "--legs", "1", "--promela", "NOWHERE"], "--promela NOWHERE: no such folder"),
     ("promela is a file", ["post", "--legs", "1", "--promela", "FILE"], "no such folder"),
 ]
