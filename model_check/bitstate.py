@@ -42,8 +42,23 @@ HASHES = 3                        # bit positions per state (SPIN's default -k3)
 _ODD = np.uint64(0x2545F4914F6CDD1D)
 
 
+class _Omissions:
+    """What both estimates derive from the expected number of states omitted."""
+
+    states: int
+    expected_omitted: float
+
+    @property
+    def coverage(self) -> float:
+        return self.states / (self.states + self.expected_omitted) if self.states else 1.0
+
+    @property
+    def none_missed(self) -> float:
+        return math.exp(-self.expected_omitted)
+
+
 @dataclass
-class Estimate:
+class Estimate(_Omissions):
     """The printed coverage estimate of one bitstate run."""
 
     bits: int                     # log2 of the number of bits m
@@ -56,13 +71,6 @@ class Estimate:
     def hash_factor(self) -> float:
         return (1 << self.bits) / max(self.states, 1)
 
-    @property
-    def coverage(self) -> float:
-        return self.states / (self.states + self.expected_omitted) if self.states else 1.0
-
-    @property
-    def none_missed(self) -> float:
-        return math.exp(-self.expected_omitted)
 
     def text(self) -> str:
         return (f"BITSTATE search: 2^{self.bits} bits ({(1 << self.bits) / 8 / 2 ** 20:.1f} MB), k = {self.hashes} "
@@ -153,7 +161,7 @@ def explore_hash_compact(model: Model, bits: int, compiled: Compiled | None = No
 
 
 @dataclass
-class CompactEstimate:
+class CompactEstimate(_Omissions):
     """The printed estimate of one hash-compact run: with n signatures of b bits drawn at random, new state i
     meets one of the i stored signatures with probability i / 2^b (the birthday bound), so about
     n (n - 1) / 2^(b + 1) states are omitted, and none at all with probability e^(-that)."""
@@ -165,13 +173,6 @@ class CompactEstimate:
     def expected_omitted(self) -> float:
         return self.states * (self.states - 1) / 2 ** (self.bits + 1)
 
-    @property
-    def coverage(self) -> float:
-        return self.states / (self.states + self.expected_omitted) if self.states else 1.0
-
-    @property
-    def none_missed(self) -> float:
-        return math.exp(-self.expected_omitted)
 
     def text(self) -> str:
         return (f"HASH-COMPACT search: {self.bits}-bit signatures, {self.states:,} stored ({8 * self.states / 2 ** 20:.1f} MB);"
