@@ -24,7 +24,7 @@ host-supplied NetConfig: nothing here is a number of its own.
 from __future__ import annotations
 
 from collections import deque
-from typing import Any, Callable
+from typing import Any, Callable, NamedTuple
 
 from arachnae_proto import CodecError
 from arachnae_proto.frame import OVERHEAD, Frame, build, check
@@ -32,7 +32,7 @@ from arachnae_proto.messages import Message
 from arachnae_proto.network import ADDRESS_OF, BROADCAST, BUSES, NODES
 
 from behaviours.hardware import Hardware
-from behaviours.netconfig import Config
+from behaviours.netconfig import Config, NetConfig
 
 Reply = Callable[[int, Message], None]
 PREEMPT = 2        # Runtime.request: transactions of this priority or higher pass one still waiting out its defer
@@ -57,6 +57,30 @@ class BusTiming:
         self.slot_s = OVERHEAD * self.char_s + self.gap_s
         self.timeout_s = b.response_timeout_ms / 1000
         self.id_retries = b.id_retries
+
+
+class SlaveQuiet(NamedTuple):
+    """Idle line time (s) a slave waits before it starts a frame of its own (Runtime._slave_start), by what the
+    line carried last; the rank stagger and the reflex lead included. firmware/roles.py writes these for the C."""
+    after_master: float
+    after_other: float
+    in_window: float
+
+
+def slave_quiet(t: BusTiming, net: NetConfig, rank: int, reflex_request: bool) -> SlaveQuiet:
+    """The idle times of Runtime._slave_start (see there for why) for a slave of arbitration rank `rank`."""
+    # seed 5.2 / spec arbitration reflex_lead_bits: an ordinary request waits longer than a reflex one
+    lead = 0.0 if not net.reflexes or reflex_request else net.reflex_lead_bits * t.bit_s
+    extra = rank * 2 * t.bit_s + lead
+    # two characters short of the master's defer: the line is polled a character at a time
+    after_master = min(t.timeout_s, net.protocol.master_defer_slots * t.slot_s - 2 * t.char_s)
+    return SlaveQuiet(after_master + extra, t.gap_s + t.char_s + extra, t.turnaround_s + extra)
+
+
+def arbitration_rank(net: NetConfig, bus: str, address: int) -> int:
+    """A slave's arbitration rank on `bus` (spec rank_order: declared priority, then address)."""
+    slaves = net.requesters.get(bus, ())
+    return slaves.index(address) if address in slaves else len(slaves)
 
 
 def slaves_of(bus: str) -> list[int]:
@@ -278,19 +302,18 @@ class Runtime:
         frame already waiting for the line goes first); inside the backoff window after a corrupt frame, for
         the turnaround (the master keeps off the line); plus two bit times per rank among the bus's
         requesting slaves, so two slaves waiting for the same idle line start apart and the later one hears
-        the first one's carrier; plus the reflex lead for an ordinary request (reflex_lead_s)."""
+        the first one's carrier; plus the reflex lead for an ordinary request (slave_quiet)."""
         q = self._slave_out.get(bus)
         if not q:
             return
         t = self._timing(bus)
+        need = slave_quiet(t, self.net, self.rank(bus), self.reflex_request(bus))
         if self._in_window(bus):
-            quiet = t.turnaround_s
+            quiet = need.in_window
         elif self._after_master.get(bus, True):
-            # two characters short of the defer: the line is polled a character at a time (below)
-            quiet = min(t.timeout_s, self.net.protocol.master_defer_slots * t.slot_s - 2 * t.char_s)
+            quiet = need.after_master
         else:
-            quiet = t.gap_s + t.char_s
-        quiet += self.rank(bus) * 2 * t.bit_s + self.reflex_lead_s(bus)
+            quiet = need.after_other
         idle = self.hw.line_idle_s(bus)
         if idle <= quiet:                        # first the line, so a frame on it cannot cost our slot
             self.hw.after(quiet - idle + t.char_s if idle > 0 else t.char_s, self._slave_start, bus)
@@ -307,14 +330,6 @@ class Runtime:
         """Does the request this slave is about to start on `bus` carry a reflex record (spec reflexes)?
         The reflex's source always does; a relaying sub-master overrides this for the records it holds."""
         return self.net.reflex_from(self.address) is not None  # type: ignore[attr-defined]
-
-    def reflex_lead_s(self, bus: str) -> float:
-        """seed 5.2 / spec arbitration reflex_lead_bits: an ordinary request waits this many bit times longer
-        than a reflex one would in the same idle stretch, so the reflex is on the line first and the other
-        hears its carrier and defers."""
-        if not self.net.reflexes or self.reflex_request(bus):
-            return 0.0
-        return self.net.reflex_lead_bits * self._timing(bus).bit_s
 
     def _slave_echo(self, bus: str, sent: bytes, heard: bytes) -> None:
         q = self._slave_out.get(bus)
@@ -412,5 +427,4 @@ class Runtime:
 
     def rank(self, bus: str) -> int:
         """This slave's arbitration rank on `bus` (spec rank_order: declared priority, then address)."""
-        slaves = self.net.requesters.get(bus, ())
-        return slaves.index(self.address) if self.address in slaves else len(slaves)  # type: ignore[attr-defined]
+        return arbitration_rank(self.net, bus, self.address)  # type: ignore[attr-defined]

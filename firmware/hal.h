@@ -21,6 +21,13 @@ void fw_rx_gap(void);
 /* Counters of main.c a debugger or a behaviour can read: frames for us, frames refused (any
  * reason, also frames for other nodes), overruns, and corrupt frames heard (collisions). */
 extern volatile uint16_t fw_rx_frames, fw_rx_errors, fw_rx_overruns, fw_rx_corrupt;
+/* What the line carried (main.c, every frame heard, whoever it was for): hal_ms() when the last corrupt
+ * frame ended, and characters of intact frames other than the bus's request message (the backoff window's
+ * slots are idle slots, behaviours/runtime.py). */
+extern volatile uint16_t fw_rx_corrupt_ms, fw_rx_pause_chars;
+/* 1 if the last frame on the line came from the bus master or was corrupt (a polled reply may be due,
+ * runtime._slave_start): set by main.c for every frame heard, cleared by hal_send() (our own frame). */
+extern volatile uint8_t fw_rx_from_master;
 
 void hal_init(void);
 void hal_enable_interrupts(void);

@@ -19,12 +19,35 @@ static FW_ROLE_NODE node;
 volatile uint16_t fw_rx_frames, fw_rx_errors, fw_rx_overruns;
 /* Frames heard corrupt (CRC, cut short, too long): a collision on the bus, whoever it was for. */
 volatile uint16_t fw_rx_corrupt;
+volatile uint16_t fw_rx_corrupt_ms, fw_rx_pause_chars;
 
-static void count_error(arachnae_status st)
+/* OVERSIZE from a frame longer than our buffer (a frame for another node: the parser stops at its length
+ * byte), not a corrupt one: counting it as a collision would keep every slave's backoff window open. */
+static uint8_t too_long(void)
+{
+    return (uint8_t)((uint16_t)(ARACHNAE_FRAME_OVERHEAD + rx_buf[ARACHNAE_FRAME_LENGTH]) > FW_RX_MAX);
+}
+
+/* Interrupt context: a frame heard whole (st: the parser's verdict) that ended `ago_ms` before now. */
+static void heard(arachnae_status st, uint16_t ago_ms)
+{
+    if (st == ARACHNAE_CHECKSUM || st == ARACHNAE_TRUNCATED || (st == ARACHNAE_OVERSIZE && !too_long())) {
+        fw_rx_corrupt_ms = (uint16_t)(hal_ms() - ago_ms);
+        fw_rx_corrupt++;
+        fw_rx_from_master = 1;      /* source unknown: as after the master's frame (runtime.on_line_frame) */
+        return;
+    }
+    /* the envelope is intact (the parser checks CRC before address and payload), or too long for us to
+       check (too_long): its source and length are taken as they came */
+    fw_rx_from_master = (uint8_t)(rx_buf[ARACHNAE_FRAME_SRC] == FW_MASTER_ADDRESS);
+    if (rx_buf[ARACHNAE_FRAME_OPCODE] != FW_REQUEST_OPCODE)
+        fw_rx_pause_chars = (uint16_t)(fw_rx_pause_chars + ARACHNAE_FRAME_OVERHEAD + rx_buf[ARACHNAE_FRAME_LENGTH]);
+}
+
+static void count_error(arachnae_status st, uint16_t ago_ms)
 {
     fw_rx_errors++;
-    if (st == ARACHNAE_CHECKSUM || st == ARACHNAE_TRUNCATED || st == ARACHNAE_OVERSIZE)
-        fw_rx_corrupt++;
+    heard(st, ago_ms);
 }
 
 /* RX interrupt context. */
@@ -36,9 +59,10 @@ void fw_rx_byte(uint8_t byte)
     if (st == ARACHNAE_NONE)
         return;
     if (st != ARACHNAE_OK) {
-        count_error(st);
+        count_error(st, 0);
         return;
     }
+    heard(st, 0);
     if (frame_ready) {              /* main loop still busy with the previous frame */
         fw_rx_overruns++;
         return;
@@ -56,7 +80,7 @@ void fw_rx_gap(void)
 {
     arachnae_status st = arachnae_parser_gap(&parser);
     if (st != ARACHNAE_NONE)
-        count_error(st);  /* a frame cut short (TRUNCATED) */
+        count_error(st, (uint16_t)(FW_IDLE_GAP_US / 1000UL));  /* a frame cut short (TRUNCATED), a gap ago */
 }
 
 int main(void)

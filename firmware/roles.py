@@ -55,30 +55,32 @@ def role_config(spec, role: str) -> str:
         f"#define FW_OWN_ADDRESS 0x{node.address:02X}u /* {node.short} */",
     ]
     if node.bus is not None:
+        from behaviours.netconfig import NetConfig
+        from behaviours.runtime import BusTiming, arbitration_rank
         bus = spec.buses[node.bus]
         master = spec.node(bus.master)
-        # spec arbitration rank_order (declared priority, then address) among the bus's requesting slaves
-        ranked = [n.address for n in spec.requesters(node.bus)] or sorted(n.address for n in spec.slaves(node.bus))
-        rank = ranked.index(node.address) if node.address in ranked else len(ranked)
-        slot_us = bus.frame_time_us(spec.frame.overhead) + bus.turnaround_us
+        net = NetConfig.from_spec(spec)
+        t = BusTiming(node.bus)       # the Python runtime's own figures: one formula for both
+        rank = arbitration_rank(net, node.bus, node.address)
         lines += [
             f"/* bus {bus.name}: {bus.long}, seed {bus.section} */",
             f"#define FW_BAUD {bus.baud}UL",
             f"#define FW_BITS_PER_CHAR {bus.bits_per_char}u",
-            f"#define FW_CHAR_US {round(bus.char_time_us)}UL",
-            f"#define FW_TURNAROUND_US {round(bus.turnaround_us)}UL",
+            f"#define FW_CHAR_US {round(t.char_s * 1e6)}UL",
+            f"#define FW_TURNAROUND_US {round(t.turnaround_s * 1e6)}UL",
             f"#define FW_IDLE_GAP_US {round(bus.idle_gap_us)}UL /* {bus.idle_gap_chars} characters */",
             f"#define FW_MASTER_ADDRESS 0x{master.address:02X}u /* {master.short} */",
             f"/* spec arbitration address_backoff: after a corrupt echo wait (rank + 1) slots, rank in rank_order */",
             f"#define FW_BACKOFF_RANK {rank}u",
-            f"#define FW_BACKOFF_SLOT_US {round(slot_us)}UL",
+            f"#define FW_BACKOFF_SLOT_US {round(t.slot_s * 1e6)}UL",
         ]
-        lines += slave_timing(spec, node, bus, rank, len(ranked), slot_us)
+        lines += slave_timing(net, node, t, rank)
     else:
         lines += ["#define FW_BAUD 9600UL", "#define FW_BITS_PER_CHAR 10u", "#define FW_CHAR_US 1042UL",
                   "#define FW_TURNAROUND_US 500UL", "#define FW_IDLE_GAP_US 3646UL",
                   "#define FW_MASTER_ADDRESS 0x00u", "#define FW_BACKOFF_RANK 0u", "#define FW_BACKOFF_SLOT_US 0UL",
-                  "#define FW_SLAVE_QUIET_US 0UL", "#define FW_BACKOFF_SCOPE_ALL 0u", "#define FW_BACKOFF_STEP_US 0UL",
+                  "#define FW_QUIET_AFTER_MASTER_US 0UL", "#define FW_QUIET_AFTER_OTHER_US 0UL",
+                  "#define FW_QUIET_IN_WINDOW_US 0UL", "#define FW_REQUEST_OPCODE 0x00u", "#define FW_BACKOFF_SCOPE_ALL 0u", "#define FW_BACKOFF_STEP_US 0UL",
                   "#define FW_REQUESTERS 0u"]
     lines += tuning(role) + alarm_limit(role)
     tx_max = spec.frame.overhead + max((m.max_size for m in spec.sends(role)), default=0)
@@ -101,37 +103,30 @@ def role_config(spec, role: str) -> str:
     return "\n".join(lines)
 
 
-def slave_timing(spec, node, bus, rank: int, requesters: int, slot_us: float) -> list[str]:
-    """When a slave of `bus` may start a frame of its own (DATA_RDY): the rule of behaviours/runtime.py
-    (Runtime._slave_start, AfterReplies._slave_start, _backoff_wait) as numbers for the firmware."""
-    from behaviours.netconfig import NetConfig
-    net = NetConfig.from_spec(spec)
-    bit_us = 1e6 / bus.baud
-    gap_us = max(bus.turnaround_us, bus.idle_gap_us)
-    reflex_ranks = [i for i, a in enumerate(net.requesters.get(bus.name, ())) if net.reflex_from(a)]
-    is_reflex = net.reflex_from(node.address) is not None
-    # seed 5.2 / spec reflexes: an ordinary request leads the reflex source's by reflex_lead_bits, less the
-    # rank stagger it already has behind it (AfterReplies)
-    behind = rank - min(reflex_ranks) if reflex_ranks and not is_reflex else None
-    lead_us = 0.0 if behind is None else max(0, net.reflex_lead_bits - 2 * behind) * bit_us
-    quiet_us = bus.response_timeout_ms * 1000 + rank * 2 * bit_us + lead_us
-    defer_us = net.protocol.master_defer_slots * slot_us
-    if quiet_us >= defer_us:
-        # the plain rule of Runtime._slave_start: turnaround, plus the reflex lead for an ordinary request
-        quiet_us = bus.turnaround_us + (0.0 if not net.reflexes or is_reflex
-                                        else gap_us - bus.turnaround_us + net.reflex_lead_bits * bit_us)
-    scope_all = net.arbitration.get(bus.name) == "address_backoff" and net.backoff_scope == "all"
+def slave_timing(net, node, t, rank: int) -> list[str]:
+    """When a slave of the bus may start a frame of its own (DATA_RDY): the figures of behaviours/runtime.py
+    (slave_quiet for Runtime._slave_start, the window of _backoff_wait), computed by it, for the firmware."""
+    from behaviours.runtime import slave_quiet
+    bus = node.bus
     reflex = net.reflex_from(node.address)
+    quiet = slave_quiet(t, net, rank, reflex is not None)
+    scope_all = net.arbitration.get(bus) == "address_backoff" and net.backoff_scope == "all"
     interval = [] if reflex is None else [
         "/* spec reflexes (seed 5.2): this node raises a reflex request at most this often */",
         f"#define FW_REFLEX_MIN_INTERVAL_MS {math.ceil(reflex.min_interval_s * 1000)}u"]
+    opcode = net.request_opcodes.get(bus, 0)
     return interval + [
-        "/* seed 3.2.2 'when the bus is idle': the line quiet this long before a DATA_RDY (behaviours/runtime.py) */",
-        f"#define FW_SLAVE_QUIET_US {math.ceil(quiet_us)}UL",
+        "/* seed 3.2.2 'when the bus is idle': the line quiet this long before a DATA_RDY, by what it carried last",
+        "   (behaviours.runtime.slave_quiet: rank stagger and reflex lead included) */",
+        f"#define FW_QUIET_AFTER_MASTER_US {math.ceil(quiet.after_master * 1e6)}UL",
+        f"#define FW_QUIET_AFTER_OTHER_US {math.ceil(quiet.after_other * 1e6)}UL",
+        f"#define FW_QUIET_IN_WINDOW_US {math.ceil(quiet.in_window * 1e6)}UL",
+        "/* spec arbitration request_message: frames other than requests do not use up the window's idle slots */",
+        f"#define FW_REQUEST_OPCODE 0x{opcode:02X}u",
         "/* spec address_backoff, scope all: after any corrupt frame, wait for our slot of the window */",
         f"#define FW_BACKOFF_SCOPE_ALL {1 if scope_all else 0}u",
-        f"#define FW_BACKOFF_STEP_US {round(net.backoff_slots * slot_us)}UL",
-        f"#define FW_REQUESTERS {requesters}u",
+        f"#define FW_BACKOFF_STEP_US {round(net.backoff_slots * t.slot_s * 1e6)}UL",
+        f"#define FW_REQUESTERS {len(net.requesters.get(bus, ()))}u",
     ]
 
 

@@ -46,11 +46,13 @@ FIRMWARE = Path(__file__).resolve().parent
 BUILD = FIRMWARE / "build"
 HOST = BUILD / "sil" / "sil_host"
 F_CPU = 16_000_000
+CARRIER_MARGIN = 0.2      # characters past the first byte's RXC before carrier detect drops
 SYNC_S = 0.001            # simulated time between two syncs of the AVR with the simulation
 DE_PIN = "D2"             # RS-485 driver enable (avr/hal_avr.c)
 TEST_POINT = "B5"         # pulsed by the firmware when it detects a stimulus
 INPUT_PINS = ("C0", "C1")  # sensor switches, active low (avr/hal_avr.c)
 CD_PIN = "C2"             # collision-detect latch, set on a corrupt echo
+CARRIER_PIN = "C3"        # carrier detect: high from another station's start bit to its first byte (hal_avr.c)
 
 AVR_DATA = 0x800000       # avr-gcc's offset of data-space symbols
 
@@ -206,6 +208,7 @@ class SilNode:
         self.host = SilHost(self.elf)
         self.frames_sent = 0
         self.stimuli = 0
+        self.carrier = False      # CARRIER_PIN is high
 
     # -- time --------------------------------------------------------------
     @property
@@ -233,6 +236,12 @@ class SilNode:
         self._advance(t0)
         for i, b in enumerate(data):
             self.host.inject(max(self.host.cycle, self._cycles(t0 + i * self.char_s)), b)
+        if self.carrier:
+            # carrier detect holds until the first byte is in (RXC, one character after the start bit):
+            # from then on the UART's gap timer tells the firmware a frame is coming in
+            self._advance(t0 + (1 + CARRIER_MARGIN) * self.char_s)
+            self.host.set_pin(CARRIER_PIN, 0)
+            self.carrier = False
 
     def on_echo(self, bus: str, sent: bytes, heard: bytes) -> None:
         if self.hw.alive and heard != sent:
@@ -256,12 +265,19 @@ class SilNode:
             return
         target = self.now
         port = self.hw.ports.get(self.bus_name)
+        starts: list[float] = []
         if port is not None:
             # never run past the start of a frame still on the wire: its bytes arrive at receive()
             starts = [tx.start for tx in port.bus.active if tx.port is not port]
             if starts:
                 target = min(target, min(starts))
         self._advance(target)
+        if bool(starts) != self.carrier:
+            # seed 3.2.2 "when the bus is idle": the firmware senses the start bit (bus.py's carrier
+            # sense) instead of starting its own frame before the first byte of this one is in; it drops
+            # at the first byte (receive) or, for a frame this node does not hear (lost), at its end
+            self.host.set_pin(CARRIER_PIN, 1 if starts else 0)
+            self.carrier = bool(starts)
         self.hw.after(self.sync_s, self._sync)
 
     def _advance(self, t: float) -> None:
@@ -356,8 +372,11 @@ class SilNode:
             if done or (not events and self.host.cycle >= last + quiet):
                 break
         self.frames_sent += 1
-        delay = max(0.0, self._time(first_cycle) - self.now)
-        self.hw.after(delay, self.transmit, self.bus_name, bytes(frame))
+        driven = self._time(first_cycle)
+        if driven >= self.now:
+            self.hw.after(driven - self.now, self.transmit, self.bus_name, bytes(frame))
+        else:   # seen up to a sync period late: the bus judges its carrier sense at the time it drove the line
+            self.transmit(self.bus_name, bytes(frame), driven)
 
 
 @lru_cache(maxsize=None)

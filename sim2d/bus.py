@@ -73,11 +73,15 @@ class Port:
         self.muted = False
         self.killed = False
         self._pending = False
+        self.driven_at: float | None = None   # when the station drove the line, if before it reached the bus
 
-    def send(self, data: bytes) -> None:
-        """Queue a frame; it goes out when the line is free (in order, one at a time)."""
+    def send(self, data: bytes, driven_at: float | None = None) -> None:
+        """Queue a frame; it goes out when the line is free (in order, one at a time). `driven_at`: a
+        co-simulated station (firmware/sil_bridge.py) reports its frames up to a sync period late; its carrier
+        sense is judged at the time it drove the line."""
         if self.killed:
             return
+        self.driven_at = driven_at
         self.queue.append(bytes(data))
         if not self._pending:
             self._pending = True
@@ -144,12 +148,14 @@ class Bus:
             return
         if self.active and not self._unheard(port.owner, port.queue[0][2] if len(port.queue[0]) > 2 else None):
             first = min(tx.start for tx in self.active)
-            if now - first >= self.bit_time:
+            driven, port.driven_at = port.driven_at, None
+            if (now if driven is None else min(now, driven)) - first >= self.bit_time:
                 port._pending = False   # carrier sensed: _finish() reschedules waiting ports
                 return
         elif now < self.idle_at + self.turnaround and self.idle_at > 0:
             self.sched.at(self.idle_at + self.turnaround, self._try_start, port)
             return
+        port.driven_at = None
         data = port.queue.pop(0)
         tx = Transmission(port, data, now, now + self.frame_time(len(data)))
         if port.muted:

@@ -36,10 +36,10 @@ class NodeHardware:
         if self.alive:
             fn(*args)
 
-    def transmit(self, bus: str, data: bytes) -> None:
-        """The skeleton's transport: bytes onto the bus, never objects."""
+    def transmit(self, bus: str, data: bytes, driven_at: float | None = None) -> None:
+        """The skeleton's transport: bytes onto the bus, never objects (driven_at: sim2d.bus.Port.send)."""
         if self.alive:
-            self.ports[bus].send(data)
+            self.ports[bus].send(data, driven_at)
 
     def line_idle_s(self, bus: str) -> float:
         return self.ports[bus].bus.idle_for(self.node.short)

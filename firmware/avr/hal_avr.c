@@ -3,7 +3,9 @@
  * USART0 8N1 at the role's bus baud; PD2 drives the RS-485 DE and /RE together,
  * the receiver is off while sending; PC2 reads the collision-detect latch (hal.h).
  * Timer0: 1 ms tick. Timer1: one-shot idle-gap timer, restarted by every byte.
- * Inputs on PC0..PC1 (active low, pull-ups); test point on PB5.
+ * Inputs on PC0..PC1 (active low, pull-ups); test point on PB5. PC3: carrier detect, the
+ * transceiver's RO through a retriggerable monostable of one character: high from a frame's
+ * start bit on, before its first byte is in (hal_line_quiet_ms).
  */
 #include <avr/interrupt.h>
 #include <avr/io.h>
@@ -30,6 +32,7 @@
 static volatile uint16_t ms;
 static volatile uint16_t last_rx_ms;
 static volatile uint16_t tx_end_ms;
+volatile uint8_t fw_rx_from_master = 1;   /* hal.h; nothing heard yet counts as the master's */
 static uint8_t sent;   /* 1 once hal_send() ran: there is an echo to judge */
 
 void hal_init(void)
@@ -37,7 +40,7 @@ void hal_init(void)
     DDRD |= _BV(PD2);                 /* DE, low: listening */
     PORTD &= (uint8_t)~_BV(PD2);
     DDRB |= _BV(PB5);                 /* test point */
-    DDRC &= (uint8_t)~(_BV(PC0) | _BV(PC1) | _BV(PC2));
+    DDRC &= (uint8_t)~(_BV(PC0) | _BV(PC1) | _BV(PC2) | _BV(PC3));
     PORTC |= _BV(PC0) | _BV(PC1);     /* pull-ups: a closed switch reads 0 */
 
     UBRR0H = UBRRH_VALUE;
@@ -120,6 +123,7 @@ void hal_send(const uint8_t *frame, uint16_t len)
         ;
     PORTD &= (uint8_t)~_BV(PD2);
     UCSR0B |= _BV(RXEN0);
+    fw_rx_from_master = 0;                      /* the line's last frame is ours (hal.h) */
     tx_end_ms = hal_ms();
     sent = 1;
 }
@@ -135,7 +139,7 @@ uint16_t hal_line_quiet_ms(void)
 {
     uint16_t now = hal_ms(), rx;
     ATOMIC_BLOCK(ATOMIC_RESTORESTATE) { rx = last_rx_ms; }
-    if (TCCR1B != 0u)                           /* a frame is coming in */
+    if (TCCR1B != 0u || (PINC & _BV(PC3)))       /* a frame is coming in, or just began */
         return 0;
     rx = (uint16_t)(now - rx);
     return sent && (uint16_t)(now - tx_end_ms) < rx ? (uint16_t)(now - tx_end_ms) : rx;

@@ -32,6 +32,7 @@
 static volatile uint16_t ms, last_rx_ms;
 static volatile uint8_t gap_armed;
 static volatile uint16_t tx_end_ms;
+volatile uint8_t fw_rx_from_master = 1;   /* hal.h; nothing heard yet counts as the master's */
 static uint8_t sent;
 
 void hal_init(void)
@@ -91,6 +92,7 @@ void hal_send(const uint8_t *frame, uint16_t len)
             ;
     }
     GPIO_OUTCLR = PIN_DE;
+    fw_rx_from_master = 0;                      /* the line's last frame is ours (hal.h) */
     tx_end_ms = ms;
     sent = 1;
 }

@@ -82,7 +82,7 @@ def test_tpsc_firmware_answers_id_req_and_status_req_like_the_python_codec(host_
 
 def test_tpsc_initiates_and_resends_after_a_corrupt_echo(host_factory, spec):
     """seed 3.2.12: the TPSC always initiates; seed 3.2.2 + address_backoff (scope all): after the corrupt echo
-    it resends in its slot of the window (rank 0: the first) once the line was quiet for the response timeout."""
+    it resends in its slot of the window (rank 0: the first) once the line was quiet for the window's idle time."""
     from arachnae_proto import frame, messages
     h = host_factory("avr/tpsc.elf")
     for pin in ("C0", "C1"):
@@ -100,14 +100,15 @@ def test_tpsc_initiates_and_resends_after_a_corrupt_echo(host_factory, spec):
     ev = run_like_the_bridge(h, h.cycle + 150 * MS)
     again = [e for e in ev if e[0] == "t"]
     assert tx_bytes(ev) == frame.build(0x04, 0x28, messages.DataRdy())    # resent once, then its echo is good
-    bus = spec.buses["sensor"]
-    slot = bus.frame_time_us(spec.frame.overhead) + bus.turnaround_us
-    rank = [n.address for n in spec.requesters("sensor")].index(0x28)     # spec rank_order
+    from behaviours.netconfig import NetConfig
+    from behaviours.runtime import BusTiming, arbitration_rank, slave_quiet
+    net, t = NetConfig.from_spec(spec), BusTiming("sensor")
+    rank = arbitration_rank(net, "sensor", 0x28)                          # spec rank_order
     quiet_ms = (again[0][1] - released) / MS
-    # AfterReplies for the reflex source (rank 0): the line quiet for the response timeout; the firmware
-    # counts whole 1 ms ticks, so up to one tick less; its slot of the window is the first one
-    assert rank == 0 and slot > 0
-    assert bus.response_timeout_ms - 1 < quiet_ms < bus.response_timeout_ms + 60, quiet_ms
+    # Runtime._slave_start inside the window after our corrupt frame: the line quiet for the window's idle
+    # time, and the reflex source (rank 0) resends in the first slot of the window, which starts as our frame ends
+    assert rank == 0
+    assert slave_quiet(t, net, rank, True).in_window * 1e3 < quiet_ms < net.backoff_slots * t.slot_s * 1e3, quiet_ms
     send(h, frame.build(0x28, 0x04, messages.XmitData()))
     out = tx_bytes(run_like_the_bridge(h, h.cycle + 80 * MS))
     assert frame.parse(out).message == messages.XmitDataTpsc(contact=0x20)   # OBJ_RIGHT

@@ -45,6 +45,21 @@ def test_half_duplex_second_sender_waits_for_idle_plus_turnaround():
     assert bus.stats.collisions == 0
 
 
+def test_a_frame_reported_late_is_carrier_judged_when_it_was_driven():
+    """firmware/sil_bridge.py hands a firmware frame over up to a sync period late: one driven before the
+    other frame's carrier could be sensed collides with it, as on the wire; one driven later still waits."""
+    sched, bus, port, _got, _, trace = make()
+    a, b, c = port("a"), port("b"), port("c")
+    a.send(b"\xaa" * 10)
+    sched.at(0.002, b.send, b"\xbb" * 4, 0.0)          # driven at 0: with a's start bit, not after it
+    sched.at(0.003, c.send, b"\xcc" * 4, 0.002)        # driven 2 ms into a's frame: carrier sensed
+    sched.run_until(1.0)
+    by = {e.sender: e for e in trace}
+    assert "collision" in by["a"].flags and "collision" in by["b"].flags
+    assert by["c"].start == pytest.approx(by["a"].end + 500e-6) and "collision" not in by["c"].flags
+    assert bus.stats.collisions == 2
+
+
 def test_two_senders_starting_together_collide_and_see_it_in_their_echo():
     sched, bus, port, got, echoes, _ = make()
     a, b, c = port("a"), port("b"), port("c")

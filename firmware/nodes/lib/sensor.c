@@ -97,20 +97,22 @@ uint8_t fw_three_plus_three(uint8_t kind, uint16_t arg, uint8_t channels, uint8_
     return 0;
 }
 
-/* fw_rx_corrupt is written by the RX interrupt: read until two reads agree (no torn 16-bit value) */
-static uint16_t rx_errors(void)
+/* written by the RX interrupt: read until two reads agree (no torn 16-bit value) */
+static uint16_t isr_word(volatile uint16_t *v)
 {
     uint16_t e;
     do {
-        e = fw_rx_corrupt;
-    } while (e != fw_rx_corrupt);
+        e = *v;
+    } while (e != *v);
     return e;
 }
+
+static uint16_t rx_errors(void) { return isr_word(&fw_rx_corrupt); }
 
 void fw_slave_init(fw_slave *s, uint8_t own)
 {
     s->own = own;
-    s->pending = s->waiting_echo = s->announced = s->collided = 0;
+    s->pending = s->waiting_echo = s->announced = s->collided = s->slot_used = 0;
     s->rx_errors = rx_errors();
 }
 
@@ -125,31 +127,59 @@ void fw_announce(fw_slave *s, uint16_t now, uint8_t force)
 
 void fw_fetched(fw_slave *s) { s->announced = 0; }
 
-#define US_TO_MS_UP(us) ((uint16_t)(((us) + 999UL) / 1000UL))
+/* hal_ms() ticks: a span read as n ms lasted more than n - 1 ms and less than n + 1 ms */
+#define TICK_US 1000UL
 
-/* runtime._backoff_wait: 1 while this slave must wait for its slot of the window after a collision */
-static uint8_t backing_off(fw_slave *s, uint16_t now)
+/* Microseconds of the backoff window (runtime._in_window, _backoff_wait) gone since the corrupt frame:
+ * idle slots, so the line time of frames other than requests heard since then does not count. */
+static uint32_t window_us(const fw_slave *s, uint16_t now)
 {
-    uint16_t since, mine, step;
+    uint32_t since = (uint32_t)(uint16_t)(now - s->collision_at) * TICK_US;
+    uint32_t pause = (uint32_t)(uint16_t)(isr_word(&fw_rx_pause_chars) - s->pause_at) * FW_CHAR_US;
+    return since > pause ? since - pause : 0u;
+}
+
+/* runtime._in_window: the window after a collision is still open (scope all). */
+static uint8_t in_window(fw_slave *s, uint16_t now)
+{
     if (!FW_BACKOFF_SCOPE_ALL || !s->collided)
         return 0;
-    step = US_TO_MS_UP(FW_BACKOFF_STEP_US);
-    since = (uint16_t)(now - s->collision_at);
-    mine = (uint16_t)(FW_BACKOFF_RANK * step);
-    if (since >= (uint16_t)(FW_REQUESTERS * step)) {
+    if (window_us(s, now) >= FW_REQUESTERS * FW_BACKOFF_STEP_US + TICK_US) {
         s->collided = 0;                     /* the window is over */
         return 0;
     }
-    return (uint8_t)(since < mine || since >= (uint16_t)(mine + step));
+    return 1;
+}
+
+/* runtime._backoff_wait: 1 while this slave must wait for its slot of the window (rank x step), the slot
+ * shrunk by the clock's tick at both ends so the request starts inside it whatever the tick's phase. */
+static uint8_t backing_off(fw_slave *s, uint16_t now)
+{
+    uint32_t since, mine = FW_BACKOFF_RANK * FW_BACKOFF_STEP_US;
+    if (!in_window(s, now))
+        return 0;
+    since = window_us(s, now);
+    return (uint8_t)(s->slot_used || since < mine + TICK_US || since + 2u * TICK_US >= mine + FW_BACKOFF_STEP_US);
+}
+
+/* A corrupt frame ended `at` (hal_ms): the window starts again (runtime._open_window). */
+static void open_window(fw_slave *s, uint16_t at)
+{
+    s->collided = 1;
+    s->slot_used = 0;
+    s->collision_at = at;
+    s->pause_at = isr_word(&fw_rx_pause_chars);
 }
 
 void fw_slave_poll(fw_slave *s, uint16_t now)
 {
+    uint8_t out[ARACHNAE_DATA_RDY_FRAME_MAX];
+    uint16_t n = 0;
+    uint32_t quiet;
     uint16_t errors = rx_errors();
     if (errors != s->rx_errors) {            /* runtime.on_codec_error: a corrupt frame on the bus */
         s->rx_errors = errors;
-        s->collided = 1;
-        s->collision_at = now;
+        open_window(s, isr_word(&fw_rx_corrupt_ms));
     }
     if (s->waiting_echo) {
         uint8_t e = hal_echo_status();
@@ -159,20 +189,26 @@ void fw_slave_poll(fw_slave *s, uint16_t now)
         if (e == HAL_ECHO_OK) {
             s->pending = 0;
         } else {                              /* seed 3.2.2: corrupt echo, send again after our slot */
-            s->collided = 1;
-            s->collision_at = now;
+            fw_rx_from_master = 1;            /* our frame ended corrupt, the echo is FW_CD_WAIT_MS old */
+            open_window(s, (uint16_t)(now - FW_CD_WAIT_MS));
         }
     }
-    if (!s->pending || backing_off(s, now))
+    if (!s->pending)
         return;
-    /* seed 3.2.2 "when the bus is idle": quiet for longer than FW_SLAVE_QUIET_US (AfterReplies) */
-    if ((uint32_t)hal_line_quiet_ms() * 1000UL > FW_SLAVE_QUIET_US) {
-        uint8_t out[ARACHNAE_DATA_RDY_FRAME_MAX];
-        uint16_t n = 0;
-        if (arachnae_data_rdy_build(FW_MASTER_ADDRESS, s->own, out, sizeof out, &n) == ARACHNAE_OK) {
-            hal_send(out, n);
-            s->waiting_echo = 1;
-        }
+    /* seed 3.2.2 "when the bus is idle" (runtime._slave_start): quiet for longer than the time for what the
+     * line carried last, counted in whole ticks; first the line, then our slot of the window */
+    if (in_window(s, now))
+        quiet = FW_QUIET_IN_WINDOW_US;
+    else if (fw_rx_from_master)
+        quiet = FW_QUIET_AFTER_MASTER_US;
+    else
+        quiet = FW_QUIET_AFTER_OTHER_US;
+    if ((uint32_t)hal_line_quiet_ms() * TICK_US < quiet + TICK_US || backing_off(s, now))
+        return;
+    if (arachnae_data_rdy_build(FW_MASTER_ADDRESS, s->own, out, sizeof out, &n) == ARACHNAE_OK) {
+        s->slot_used = in_window(s, now);    /* one request per slot: the next waits for the window's end */
+        hal_send(out, n);
+        s->waiting_echo = 1;
     }
 }
 

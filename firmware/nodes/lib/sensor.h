@@ -1,7 +1,7 @@
 /*
  * What the sensor controllers on the SPU's bus share (seed 3.2.11-3.2.17), the C
  * counterpart of behaviours/sensors.py (_Sensor, AlarmLimit, _RangeSensor) and of
- * the slave side of behaviours/runtime.py (AfterReplies, address_backoff):
+ * the slave side of behaviours/runtime.py (Runtime._slave_start, address_backoff):
  * DATA_RDY announcements, SET_ALARM limits, the three-plus-three rule, means.
  * Times are hal_ms() milliseconds; numbers come from role_config.h (spec and
  * behaviours/tuning.py, firmware/roles.py), never typed in here.
@@ -43,7 +43,9 @@ typedef struct {
     uint8_t waiting_echo;
     uint8_t announced;      /* announced and not fetched yet */
     uint8_t collided;       /* a corrupt frame was seen: the backoff window runs from collision_at */
+    uint8_t slot_used;      /* sent in our slot of the open window */
     uint16_t announced_at, collision_at, rx_errors;
+    uint16_t pause_at;      /* fw_rx_pause_chars when the window opened */
 } fw_slave;
 
 void fw_slave_init(fw_slave *s, uint8_t own);
