@@ -338,9 +338,12 @@ class Validator:
         own = [f for f in frames if f.line not in service and not self.is_request(r, f)]
         own_start = [f.start for f in own]
         worst = 0.0
+        posts = self._post_windows()
         for ep in done:
             self.report.requests += 1
             t1, t2 = ep["first"].start, ep["end"]
+            # a request raised during a POST waits for it: counted from the INIT that ends it (seed 6.3)
+            t1 = next((min(end, t2) for start, end in posts if start <= t1 < end), t1)
             if ep["how"] == "declined":
                 self.report.declined += 1
                 continue
@@ -364,6 +367,24 @@ class Validator:
                 self.report.add(ep["first"], "bound_K", f"{ep['slave']}'s request {what} after {wait:.1f} slots "
                                 f"of contention, more than K = {k} slots the checker proves for bus {r.name}")
         self.report.max_wait_slots[r.name] = max(self.report.max_wait_slots.get(r.name, 0.0), worst)
+
+    def _post_windows(self) -> list[tuple[float, float]]:
+        """The network's self tests: from the MCP's first ID_REQ of a POST to the end of the INIT broadcast
+        that closes it (seed 6.3, 3.2.3), or the trace's end when none does. Masters identify their nodes
+        then and serve no request; the K bound is the checker's arbitration model of the running network,
+        so a request raised during a POST is counted from its INIT."""
+        first_bus = self.rules.node[self.rules.mcp].masters
+        windows: list[tuple[float, float]] = []
+        start: float | None = None
+        for f in self.by_bus.get(first_bus, []):
+            if start is None and f.name == "ID_REQ" and self.src(f) == self.rules.mcp:
+                start = f.start
+            elif start is not None and f.name == "INIT" and self.dst(f) == "*":
+                windows.append((start, f.end))
+                start = None
+        if start is not None:
+            windows.append((start, self.end_t))
+        return windows
 
     # -- identification ------------------------------------------------------------------------
     def id_exchanges(self, r: BusRules, frames: list[TraceFrame]) -> None:

@@ -156,3 +156,16 @@ def test_a_move_relayed_resent_after_a_corrupt_echo_is_no_violation(saved, tmp_p
     p = cli("trace", "check", str(write(tmp_path / "t.tsv", table)), "--json")
     out = json.loads(p.stdout)
     assert ("move_retries" in out["by_rule"]) is not corrupt, out
+
+
+def test_a_request_raised_during_post_is_counted_from_its_init(tmp_path):
+    """A key typed on the RCP during the POST (seed 6.3) waits for the INIT that ends it: the masters serve no
+    request while they identify their nodes, and the K bound is the model of the running network. Counted
+    from the first XMIT_REQ, the wait was 68 slots against K = 36 (found by tests/console through a pty)."""
+    p = tmp_path / "key_in_post.yaml"
+    p.write_text(f"include: {Path(__file__).resolve().parents[2] / 'scenarios' / 'common' / 'arena.yaml'}\nname: key_in_post\nduration: 4\n"
+                 "robot: {pose: [1.0, 2.0, 0], task: idle}\noperator: [{at: 0.65, keys: F}]\n")
+    m = runner.run(str(p)).result.metrics
+    assert m["post"]["time_s"] > 0.65                          # the key came during the POST
+    assert m["protocol"]["violations"] == 0, m["protocol"]["first"]
+    assert m["protocol"]["served"] > 0 and m["nodes"]["UIC/RCP"]

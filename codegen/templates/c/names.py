@@ -100,6 +100,8 @@ def identifiers(spec: Spec, vm: dict) -> Iterator[N.Ident]:
             yield N.Ident(SCOPE, f"{rv.lname}_{hook}", at)
         for mv in rv.others:
             yield N.Ident(SCOPE, f"{rv.lname}_on_{mv.lname}", N.of_message(spec, mv.m))
+        for mv in rv.field_others:
+            yield N.Ident(f"the C union {rv.node_t}.msg", f"rx_{mv.lname}", N.of_message(spec, mv.m))
         for suffix in (".h", ".c"):
             yield N.Ident("the generated C files", f"node_{rv.lname}{suffix}", at, is_file=True)
     for mv in vm["messages"]:
@@ -107,7 +109,7 @@ def identifiers(spec: Spec, vm: dict) -> Iterator[N.Ident]:
         yield N.Ident(SCOPE, mv.op_macro, at)
         for suffix in ("MIN_SIZE", "MAX_SIZE", "FRAME_MAX"):
             yield N.Ident(SCOPE, f"ARACHNAE_{mv.name}_{suffix}", at)
-        functions = ["validate", "build"] + (["decode", "check", "encode"] if mv.has_fields else [])
+        functions = ["validate", "build"] + (["decode", "check", "encode", "unpack"] if mv.has_fields else [])
         for fn in functions:
             yield N.Ident(SCOPE, f"{mv.prefix}_{fn}", at)
         yield N.Ident("the generated C files", mv.file, at, is_file=True)
