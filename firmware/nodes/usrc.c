@@ -29,13 +29,7 @@ static usrc_state st;
 
 static void declare(uint8_t status, uint16_t now)
 {
-    if (status == st.status)
-        return;
-    st.status = status;
-    fw_debug[FW_DBG_STATUS] = status;
-    hal_note(HAL_NOTE_STATUS, status);
-    if (!st.free_run)
-        fw_announce(&st.slave, now, 0);     /* CHOICE: a status change is news for the SPU */
+    fw_declare(&st.slave, &st.status, status, st.free_run, now);
 }
 
 static void measure(uint16_t now)

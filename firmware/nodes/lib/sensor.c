@@ -116,6 +116,17 @@ void fw_slave_init(fw_slave *s, uint8_t own)
     s->rx_errors = rx_errors();
 }
 
+void fw_declare(fw_slave *s, uint8_t *status, uint8_t new_status, uint8_t free_run, uint16_t now)
+{
+    if (new_status == *status)
+        return;
+    *status = new_status;
+    fw_debug[FW_DBG_STATUS] = new_status;
+    hal_note(HAL_NOTE_STATUS, new_status);
+    if (!free_run)
+        fw_announce(s, now, 0);     /* CHOICE: a status change is news for the SPU */
+}
+
 void fw_announce(fw_slave *s, uint16_t now, uint8_t force)
 {
     if (!force && s->announced && (uint16_t)(now - s->announced_at) < TUNING_SENSOR_DATA_RDY_RETRY_MS)

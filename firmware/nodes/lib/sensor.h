@@ -53,6 +53,9 @@ void fw_slave_init(fw_slave *s, uint8_t own);
  * `force`: whatever was announced. */
 void fw_announce(fw_slave *s, uint16_t now, uint8_t force);
 void fw_fetched(fw_slave *s);
+/* A range sensor's new reliability status (seed 3.2.11/3.2.13): recorded, noted on the debug port and,
+ * unless it is free-running, announced to the SPU. Nothing happens if it did not change. */
+void fw_declare(fw_slave *s, uint8_t *status, uint8_t new_status, uint8_t free_run, uint16_t now);
 /* From the behaviour's poll: sends the pending DATA_RDY when the rules allow, judges its echo. */
 void fw_slave_poll(fw_slave *s, uint16_t now);
 
