@@ -2,6 +2,8 @@
 VENV     := .venv
 PY       := $(VENV)/bin/python
 ARACHNAE := $(VENV)/bin/arachnae
+# pytest-xdist workers for make test's pytest suite (one per core)
+PYTEST_WORKERS ?= auto
 STAMP    := $(VENV)/.setup-stamp
 
 .PHONY: setup run test scenarios sweep-suite codegen docs spec-check check timing bench firmware size fuzz clean
@@ -20,7 +22,7 @@ run: setup
 test: setup
 	$(ARACHNAE) spec check
 	$(ARACHNAE) codegen --check
-	$(PY) -m pytest
+	$(PY) -m pytest -n $(PYTEST_WORKERS) --dist loadfile
 	$(MAKE) scenarios check firmware size fuzz
 
 ## Prove the spec's protocols; the seed's arbitration rule must yield its counterexample (exit 1).

@@ -1,5 +1,6 @@
 from __future__ import annotations
 
+import fcntl
 import subprocess
 import sys
 from pathlib import Path
@@ -14,7 +15,11 @@ def make(*targets: str, **variables: str) -> subprocess.CompletedProcess:
     """make -C firmware; a failure shows the compiler's last lines."""
     args = ["make", "-C", str(FIRMWARE), "-j2", f"PYTHON={sys.executable}", *targets]
     args += [f"{k}={v}" for k, v in variables.items()]
-    r = subprocess.run(args, capture_output=True, text=True)
+    # pytest-xdist workers share firmware/build: one make at a time, the others wait and find it up to date
+    FIRMWARE.joinpath("build").mkdir(exist_ok=True)
+    with open(FIRMWARE / "build" / ".make.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        r = subprocess.run(args, capture_output=True, text=True)
     if r.returncode != 0:
         pytest.fail(f"{' '.join(args)} failed:\n{r.stdout[-3000:]}\n{r.stderr[-3000:]}")
     return r
