@@ -413,16 +413,13 @@ class SweepResult:
     runs: int
     ran: int                        # runs executed now (the rest were finished before: a resumed sweep)
     failed: int
+    dashboard: str | None = None    # the Dask dashboard's address while the runs ran (None: nothing ran)
 
 
-def _has_dashboard() -> bool:
-    """Dask's dashboard needs bokeh (not a dependency): with it installed, a local cluster serves one."""
-    import importlib.util
+def client_for(scheduler: str | None, workers: int | None) -> Any:
+    """A client of the cluster at `scheduler`, or of a new local cluster with `workers` processes.
 
-    return importlib.util.find_spec("bokeh") is not None
-
-
-def _client(scheduler: str | None, workers: int | None) -> Any:
+    The local cluster serves Dask's dashboard (bokeh) on :8787, or on a free port when that one is taken."""
     import logging
 
     from distributed import Client, LocalCluster
@@ -433,9 +430,8 @@ def _client(scheduler: str | None, workers: int | None) -> Any:
             return Client(scheduler, timeout="15s")
         except (OSError, TimeoutError, ValueError) as exc:
             raise UserError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
-    dashboard = ":0" if _has_dashboard() else None
     cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                           dashboard_address=dashboard, silence_logs=logging.ERROR)
+                           dashboard_address=":8787", silence_logs=logging.ERROR)
     return Client(cluster)
 
 
@@ -451,14 +447,15 @@ def execute(sweep: Sweep, spec: Any, out: Path, scheduler: str | None = None, wo
     done = finished_rows(out, p)
     todo = [r for r in sweep.runs if r.run_id not in done]
     ran = 0
+    dashboard = None
     if todo:
         from distributed import as_completed
 
-        client = _client(scheduler, workers)
+        client = client_for(scheduler, workers)
         try:
-            link = getattr(client, "dashboard_link", None) if (scheduler or _has_dashboard()) else None
-            if link and progress:
-                print(f"dashboard: {link}", file=sys.stderr)
+            dashboard = getattr(client, "dashboard_link", None)
+            if dashboard and progress:
+                print(f"dashboard: {dashboard}", file=sys.stderr)
             futures = [client.submit(run_task, r.run_id, str(out / "scenarios" / f"{r.run_id}.yaml"),
                                      list(sweep.metrics), str(out / "failed" / r.run_id),
                                      key=f"arachnae-run-{p.digest[:12]}-{r.run_id}", pure=False) for r in todo]
@@ -481,10 +478,10 @@ def execute(sweep: Sweep, spec: Any, out: Path, scheduler: str | None = None, wo
             if cluster is not None:
                 cluster.close()
     if len(done) < len(sweep.runs):
-        return SweepResult(out / "results.parquet", len(sweep.runs), ran, -1)
+        return SweepResult(out / "results.parquet", len(sweep.runs), ran, -1, dashboard)
     flat = table_rows(sweep, done, out)
     write_table(flat, out / "results.parquet")
-    return SweepResult(out / "results.parquet", len(flat), ran, sum(not r["passed"] for r in flat))
+    return SweepResult(out / "results.parquet", len(flat), ran, sum(not r["passed"] for r in flat), dashboard)
 
 
 def read_table(out: Path) -> list[dict[str, Any]]:

@@ -51,7 +51,22 @@ def two_workers(folder: Path, spec) -> Path:
     s = sw.load_sweep(folder / "sweep.yaml", spec)
     res = sw.execute(s, spec, folder / "two", workers=2, progress=False)
     assert (res.runs, res.ran) == (4, 4)
+    assert res.dashboard and res.dashboard.startswith("http://")      # issue 14: the dashboard link is given
     return folder / "two"
+
+
+def test_a_local_cluster_serves_the_dask_dashboard() -> None:
+    """The link printed with the progress bar is a live page while the sweep runs (bokeh is a dependency)."""
+    from urllib.request import urlopen
+
+    client = sw.client_for(None, 1)
+    try:
+        with urlopen(client.dashboard_link, timeout=30) as page:
+            assert page.status == 200 and b"Dask" in page.read()
+    finally:
+        cluster = client.cluster
+        client.close()
+        cluster.close()
 
 
 def test_two_workers_table_and_failed_folders(two_workers: Path) -> None:
