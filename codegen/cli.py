@@ -30,6 +30,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     docs.add_argument("--spec", type=Path, default=None, metavar="DIR")
     docs.add_argument("--out", type=Path, default=Path("build/docs"), metavar="DIR",
                       help="folder for index.html (default build/docs)")
+    docs.add_argument("--force", action="store_true",
+                      help="replace an index.html there even if `arachnae docs` did not write it")
     docs.set_defaults(func=_docs)
 
 
@@ -66,7 +68,7 @@ def _docs(args: argparse.Namespace) -> int:
         raise UserError(f"--out {args.out}: exists and is not a folder")
     spec = load_spec(args.spec)
     try:
-        page = write_reference(spec, args.out)
+        page = write_reference(spec, args.out, force=args.force)
     except OSError as exc:
         raise UserError(f"--out {args.out}: cannot write ({exc.strerror or exc})") from None
     print(f"wrote {page}: {len(spec.nodes)} nodes, {len(spec.buses)} buses, {len(spec.messages)} messages")

@@ -122,6 +122,9 @@ def _preflight(files: dict[Path, bytes], out: Path) -> None:
                                 f"into it; nothing was written")
         if target.is_symlink() or target.exists() and not target.is_file():
             raise UserError(f"codegen: {target} is not a regular file, so the generator cannot replace it; nothing was written")
+        if target.exists() and not _is_generated(target):
+            raise UserError(f"codegen: {target} exists and was not written by the generator (no header line); "
+                            f"nothing was written (move it away, or choose another --out)")
 
 
 def _current(target: Path) -> bytes | None:

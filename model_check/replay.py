@@ -19,6 +19,7 @@ from typing import Any
 import yaml
 
 from arachnae.errors import UserError
+from arachnae.files import atomic_open
 from model_check import msc
 from model_check.engine import Result
 
@@ -91,9 +92,12 @@ def scenario(res: Result, variant: str, command: str) -> dict[str, Any]:
     }
 
 
+REPLAY_MARK = "Replay written by arachnae check --replay"   # in each file it writes; such files may be replaced
+
+
 def header(res: Result, variant: str, command: str) -> str:
     v = res.violation
-    lines = [f"Replay of a counterexample of `{command}` ({res.model.name}):",
+    lines = [f"{REPLAY_MARK}: a counterexample of `{command}` ({res.model.name}):",
              f"{v.kind} {v.prop} violated" + (f" ({v.detail})." if v.detail else "."),
              f"Run with the {variant} arbitration rule on the real node code; the model's environment steps:"]
     for e in _schedule(res):
@@ -114,13 +118,19 @@ def write(res: Result, out_dir: str, command: str) -> list[Path]:
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise UserError(f"--replay: {out_dir} is not a directory")
-    out.mkdir(parents=True, exist_ok=True)
     variants = [m.origin["variant"]] + (["spec"] if m.origin["variant"] == "seed" else [])
-    written = []
+    files: dict[Path, str] = {}
     for variant in variants:
         sc = scenario(res, variant, command)
-        path = out / f"{sc['name']}.yaml"
-        path.write_text(header(res, variant, command) + yaml.safe_dump(sc, sort_keys=False, default_flow_style=None))
-        written.append(path)
-    (out / f"counterexample_{m.origin['bus']}.json").write_text(json.dumps(msc.to_json(res, res.violation), indent=2) + "\n")
-    return written
+        files[out / f"{sc['name']}.yaml"] = header(res, variant, command) + yaml.safe_dump(
+            sc, sort_keys=False, default_flow_style=None)
+    trace = dict(msc.to_json(res, res.violation), written_by=REPLAY_MARK)
+    files[out / f"counterexample_{m.origin['bus']}.json"] = json.dumps(trace, indent=2) + "\n"
+    for path in files:      # issue 10.1: a file of the user's by the same name is never replaced
+        if path.is_symlink() or (path.exists() and not (path.is_file() and REPLAY_MARK in path.read_text(errors="replace"))):
+            raise UserError(f"--replay: {path} exists and was not written by --replay; nothing was written")
+    out.mkdir(parents=True, exist_ok=True)
+    for path, text in files.items():
+        with atomic_open(path, "w") as fh:
+            fh.write(text)
+    return [p for p in files if p.suffix == ".yaml"]

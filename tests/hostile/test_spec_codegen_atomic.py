@@ -41,7 +41,13 @@ def _out_is_a_file(out: Path) -> Path:
     return out
 
 
+def _users_file_at_a_generated_path(out: Path) -> Path:
+    (out / "c" / "arachnae.h").write_text("/* my own header, not the generator's */\n")
+    return out / "c" / "arachnae.h"
+
+
 CASES = [("file_where_a_folder_belongs", _file_for_folder, "is not a folder"),
+         ("users_file_at_a_generated_path", _users_file_at_a_generated_path, "was not written by the generator"),
          ("folder_where_a_file_belongs", _folder_for_file, "is not a regular file"),
          ("symlink_where_a_file_belongs", _symlink_for_file, "is not a regular file"),
          ("out_is_a_file", _out_is_a_file, "is not a folder")]

@@ -87,3 +87,16 @@ def test_docs_out_must_be_a_folder(tmp_path, capsys):
     assert main(["docs", "--out", str(f)]) == 1
     err = capsys.readouterr().err
     assert err == f"--out {f}: exists and is not a folder\n" and f.read_text() == "keep"
+
+
+def test_docs_never_replaces_a_page_it_did_not_write(tmp_path, capsys):
+    """issue 10.1: `docs --out .` in a folder with the user's own index.html keeps it; --force overrides."""
+    page = tmp_path / "index.html"
+    page.write_text("<html>my own page</html>")
+    assert main(["docs", "--out", str(tmp_path)]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "was not written by `arachnae docs`" in err
+    assert page.read_text() == "<html>my own page</html>"
+    assert main(["docs", "--out", str(tmp_path), "--force"]) == 0
+    assert main(["docs", "--out", str(tmp_path)]) == 0          # our own page is replaced without --force
+    assert "message reference" in page.read_text()

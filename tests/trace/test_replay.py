@@ -26,7 +26,27 @@ def test_replay_writes_the_counterexample_as_scenarios(replay_dir, spec):
     assert collide["collide"] == first_two and "until" not in collide
     assert seed["faults"] == fixed["faults"]
     assert (replay_dir / "counterexample_sensor.json").exists()
-    assert (replay_dir / "replay_arbitration_sensor_seed.yaml").read_text().startswith("# Replay of a counterexample")
+    assert (replay_dir / "replay_arbitration_sensor_seed.yaml").read_text().startswith(f"# {replay.REPLAY_MARK}")
+
+
+def test_replay_never_replaces_a_users_file(replay_dir, tmp_path):
+    """issue 10.1: a file of the same name that --replay did not write stops it before it writes anything;
+    its own earlier output is replaced (the command run twice into one folder)."""
+    import subprocess
+    import sys
+
+    args = [sys.executable, "-m", "arachnae", "check", "arbitration", "--variant", "seed", "--bus", "sensor",
+            "--size", "2", "--quiet", "--replay", str(tmp_path)]
+    mine = tmp_path / "replay_arbitration_sensor_spec.yaml"
+    mine.write_text("my own scenario\n")
+    p = subprocess.run(args, capture_output=True, text=True, timeout=300)
+    assert p.returncode == 1 and p.stderr.count("\n") == 1 and "was not written by --replay" in p.stderr, p.stderr
+    assert sorted(x.name for x in tmp_path.iterdir()) == [mine.name] and mine.read_text() == "my own scenario\n"
+    mine.unlink()
+    for _ in range(2):
+        p = subprocess.run(args, capture_output=True, text=True, timeout=300)
+        assert p.returncode == 1 and "replay:" in p.stdout, p.stderr      # 1: the seed rule's counterexample
+    assert sorted(x.name for x in tmp_path.iterdir()) == sorted(x.name for x in replay_dir.iterdir())
 
 
 def test_seed_lasso_starves_a_request_in_the_simulator(replay_dir):
