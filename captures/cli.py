@@ -95,7 +95,8 @@ def sigrok_command(vcd: Path, bus: Any) -> str:
 
 def cmd_vcd(args: argparse.Namespace) -> int:
     from captures.pcapng import read_file
-    from captures.vcd import capture_vcd
+    from arachnae.files import refuse_foreign
+    from captures.vcd import VCD_MARK, capture_vcd
     from codegen.load import load_spec
 
     pcap = _capture_path(args.capture)
@@ -105,6 +106,7 @@ def cmd_vcd(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else pcap.with_suffix(".vcd")
     if not out.parent.is_dir():
         raise UserError(f"--out {out}: no such folder")
+    refuse_foreign(out, VCD_MARK, "`arachnae capture vcd`")
     buses = {n: spec.buses[n] for n in names}
     capture_vcd(out, cap.frames, buses)
     print(f"wrote {out}: {', '.join(names)} ({sum(f.bus in buses for f in cap.frames)} frames)")

@@ -18,6 +18,8 @@ from arachnae.errors import UserError
 from arachnae.files import atomic_open
 from captures.pcapng import CapturedFrame
 
+VCD_MARK = "ARACHNAE II bus lines (arachnae capture vcd)"   # the first line's comment: a VCD we may replace
+
 DATA_BITS = 8
 SAMPLES_PER_BIT = 16          # at least this many VCD time units per bit of the fastest bus written
 TAIL_CHARS = 8                # idle line after the last frame, so a decoder sees its idle gap
@@ -87,7 +89,7 @@ def timescale_text(unit_ns: int) -> str:
 def write_vcd(stream: IO[str], lines: dict[str, list[tuple[int, int]]], unit_ns: int, end: int) -> None:
     """Value changes of every line (high when idle) up to time `end`."""
     ids = {name: chr(33 + n) for n, name in enumerate(lines)}
-    stream.write(f"$comment ARACHNAE II bus lines (arachnae capture vcd) $end\n$timescale {timescale_text(unit_ns)} $end\n"
+    stream.write(f"$comment {VCD_MARK} $end\n$timescale {timescale_text(unit_ns)} $end\n"
                  "$scope module arachnae $end\n")
     for name, ident in ids.items():
         stream.write(f"$var wire 1 {ident} {name} $end\n")

@@ -16,8 +16,7 @@ from typing import Any, Iterable
 
 import jinja2
 
-from arachnae.errors import UserError
-from arachnae.files import atomic_open
+from arachnae.files import atomic_open, refuse_foreign
 from codegen.encoding import Linear, Log10
 from codegen.layout import FieldView, views
 from codegen.model import Message, Node, Spec
@@ -231,22 +230,9 @@ def write_page(path: Path, template: str, context: dict[str, Any], extra_dirs: I
 GENERATOR_META = '<meta name="generator" content="arachnae">'   # base.html.j2: marks a page as ours
 
 
-def ours(page: Path) -> bool:
-    """True when `page` was written by this toolkit (so it may be replaced): its head names the generator."""
-    try:
-        with page.open("rb") as fh:
-            return GENERATOR_META.encode() in fh.read(4096)
-    except OSError:
-        return False
-
-
 def write_reference(spec: Spec, out_dir: Path, force: bool = False) -> Path:
     """The message reference as out_dir/index.html; an index.html that is not ours is kept unless `force`."""
     page = out_dir / "index.html"
-    if page.is_symlink() or (page.exists() and not page.is_file()):
-        raise UserError(f"--out {out_dir}: {page} is not a regular file; refusing to replace it")
-    if page.exists() and not force and not ours(page):
-        raise UserError(f"--out {out_dir}: {page} exists and was not written by `arachnae docs`; "
-                        f"refusing to replace it (choose another folder, or --force)")
+    refuse_foreign(page, GENERATOR_META, "`arachnae docs`", force)
     out_dir.mkdir(parents=True, exist_ok=True)
     return write_page(page, "reference.html.j2", reference_context(spec))

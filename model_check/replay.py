@@ -19,7 +19,7 @@ from typing import Any
 import yaml
 
 from arachnae.errors import UserError
-from arachnae.files import atomic_open
+from arachnae.files import atomic_open, refuse_foreign
 from model_check import msc
 from model_check.engine import Result
 
@@ -127,8 +127,7 @@ def write(res: Result, out_dir: str, command: str) -> list[Path]:
     trace = dict(msc.to_json(res, res.violation), written_by=REPLAY_MARK)
     files[out / f"counterexample_{m.origin['bus']}.json"] = json.dumps(trace, indent=2) + "\n"
     for path in files:      # issue 10.1: a file of the user's by the same name is never replaced
-        if path.is_symlink() or (path.exists() and not (path.is_file() and REPLAY_MARK in path.read_text(errors="replace"))):
-            raise UserError(f"--replay: {path} exists and was not written by --replay; nothing was written")
+        refuse_foreign(path, REPLAY_MARK, "--replay")
     out.mkdir(parents=True, exist_ok=True)
     for path, text in files.items():
         with atomic_open(path, "w") as fh:

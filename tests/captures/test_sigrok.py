@@ -142,6 +142,20 @@ def test_cli_errors_are_one_line(bus_run, tmp_path, capsys):
     assert not list(tmp_path.glob("*.vcd")) and not list(tmp_path.glob(".*"))
 
 
+def test_vcd_never_replaces_a_users_file(bus_run, vcd, tmp_path, capsys):
+    """issue 10.1: --out naming the user's own file is refused; a VCD this command wrote is replaced."""
+    mine = tmp_path / "mine.vcd"
+    mine.write_text("my own waveforms\n")
+    assert main(["capture", "vcd", str(bus_run), "--bus", "sensor", "--out", str(mine)]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "was not written by `arachnae capture vcd`" in err
+    assert mine.read_text() == "my own waveforms\n"
+    again = tmp_path / "again.vcd"
+    again.write_bytes(vcd.read_bytes())
+    assert main(["capture", "vcd", str(bus_run), "--bus", "sensor", "--out", str(again)]) == 0
+    assert again.read_bytes() != vcd.read_bytes()            # replaced by the sensor bus alone
+
+
 def test_spec_strings_stay_python_strings(hostile_spec, monkeypatch):
     """The decoder is Python for sigrok's interpreter: spec text goes in as repr() literals, shown exactly."""
     import sys
