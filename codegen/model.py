@@ -46,6 +46,7 @@ class Node:
     section: str
     leg: int | None = None
     joint: int | None = None
+    absent: str | None = None  # a function of the node the toolkit does not implement, and why (spec nodes.absent)
 
     @property
     def ident(self) -> str:
@@ -536,7 +537,7 @@ def build(nodes_doc: dict, messages_doc: dict, sources: tuple[Path, ...], digest
     nodes = tuple(
         Node(short=n["short"], long=n["long"], address=n["address"], level=n["level"], role=n["role"],
              bus=n["bus"], masters=n.get("masters"), status=n["status"], section=n["section"],
-             leg=n.get("leg"), joint=n.get("joint"))
+             leg=n.get("leg"), joint=n.get("joint"), absent=n.get("absent"))
         for n in nodes_doc["nodes"]
     )
     buses = {

@@ -123,3 +123,8 @@ def test_generated_tables_carry_the_post_rule_units_records_and_lines(spec) -> N
     assert spec.enums["GAIT"].subset_of == spec.enums["DIRECTION"].subset_of == "MOV_CMD"
     assert {g.name: int(g) for g in Gait} == {k: int(MovCmd[k]) for k in ("TRIPOD", "RIPPLE", "WAVE")}
     assert {d.name: int(d) for d in Direction} == {m.name: int(m) for m in MovCmd if m < MovCmd.TRIPOD}
+
+
+def test_what_is_not_implemented_is_declared(spec) -> None:
+    """issue 16 item 6: the RLC's radio host link (seed 3.2.9) is declared absent with its reason, nothing else is."""
+    assert [n.short for n in spec.nodes if n.absent] == ["RLC"] and "3.2.9" in spec.node("RLC").absent
