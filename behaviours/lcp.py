@@ -34,6 +34,7 @@ import math
 from arachnae_proto import messages as M
 from arachnae_proto.enums import JointFlags, LegFlags, LegPhase, OrderStatus
 from arachnae_proto.skeletons.lcp import LcpSkeleton
+from arachnae_proto.network import NODES
 
 from behaviours import tuning as T
 from behaviours.kinematics import fk, ik, swing_point
@@ -85,8 +86,8 @@ class Segment:
 class LCP(PostMaster, Runtime, LcpSkeleton):
     def start(self) -> None:
         g = self.cfg.geometry
-        self.leg = self.net.leg_of(self.address)
-        self.jacs = sorted(slaves_of(self.master_bus), key=lambda a: self.net.joint_of(a))
+        self.leg = NODES[self.address].leg
+        self.jacs = sorted(slaves_of(self.master_bus), key=lambda a: NODES[a].joint)
         nx, ny = g.neutral_foot(self.leg)
         self.pos = (nx, ny, 0.0)
         self.target: tuple | None = None      # (phase, x, y, z) raw of the LEG_TARGET being executed
@@ -213,7 +214,7 @@ class LCP(PostMaster, Runtime, LcpSkeleton):
         q = ik(self.cfg.geometry, self.leg, *self.pos)
         refresh = self.net.protocol.setpoint_refresh_s
         for a in self.live_jacs():
-            joint = self.net.joint_of(a)
+            joint = NODES[a].joint
             raw = _DEG.raw(math.degrees(q[joint - 1]))
             last = self.sent_angles.get(joint)
             if last == raw and t - self.sent_at.get(joint, 0.0) < refresh - 1e-9:
@@ -241,7 +242,7 @@ class LCP(PostMaster, Runtime, LcpSkeleton):
     def feedback(self, src: int, fb: M.JointFeedback) -> None:
         self.misses[src] = 0
         self.servo_temp[src] = fb.temperature
-        self.measured[self.net.joint_of(src)] = math.radians(_FB_DEG.phys(fb.angle))
+        self.measured[NODES[src].joint] = math.radians(_FB_DEG.phys(fb.angle))
         if fb.flags & _J_OVERTEMP:
             if not self.hot:
                 self.hw.note("servo_overtemp", leg=self.leg, jac=src)

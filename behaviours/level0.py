@@ -206,4 +206,6 @@ class UIC_RCP(_Records, Runtime, UicRcpSkeleton):
 
 
 class RLC(Runtime, RlcSkeleton):
-    pass
+    """seed 3.2.9: identification and status (the Runtime answers ID_REQ, STATUS_REQ NOT_BUSY). The radio host link
+    is declared absent in spec/nodes.yaml (`absent`): the seed gives the modem no protocol to forward."""
+

@@ -10,7 +10,7 @@ under-voltage it starts the UIC's beeper and blinks its own LED.
 from __future__ import annotations
 
 from arachnae_proto import messages as M
-from arachnae_proto.enums import Alert, Direction, Gait, MmcError, RangeStatus, RecordKind, SscMessage
+from arachnae_proto.enums import Alert, Gait, MmcError, MovCmd, RangeStatus, RecordKind, SscMessage
 from arachnae_proto.network import ADDRESS_OF, BROADCAST, NODES
 from arachnae_proto.skeletons.mcp import McpSkeleton
 
@@ -19,6 +19,8 @@ from behaviours.post import PostMaster, Verdict, behind, verdict
 from behaviours.runtime import PRIORITY_GRANT, PRIORITY_REFLEX, PRIORITY_RELAY, Runtime
 
 _GAITS = frozenset(int(g) for g in Gait)
+# seed 3.2.2: what a granted slave may answer with: the records the MCP receives (spec messages.<m>.record)
+_RECORDS = tuple(cls for cls in McpSkeleton.RECEIVES if cls.RECORD)
 _ALARM, _STATUS = int(RecordKind.ALARM), int(RecordKind.STATUS)
 _IN_ORDER = int(RangeStatus.IN_ORDER)
 _LCD_WIDTH = next(f for f in M.LcdText.FIELDS if f.name == "length").conv.hi
@@ -56,6 +58,7 @@ class MCP(PostMaster, Runtime, McpSkeleton):
     def start(self) -> None:
         self.requests: list[int] = []
         self.serving = False
+        self.fetching: int | None = None                     # the slave granted the bus, whose record is due
         self.halted = False
         self.mmc_state: tuple[int, int] | None = None       # (error, leg) last told to the NP3
         self.faults: dict[tuple[int, int], int] = {}         # (source, channel) -> last non-zero status relayed
@@ -71,7 +74,7 @@ class MCP(PostMaster, Runtime, McpSkeleton):
     # --- POST (seed 6.3) -------------------------------------------------------------------
     def post_done(self, missing: list[int]) -> None:
         again = self.verdict is not None
-        self.verdict = verdict(self.net, missing)
+        self.verdict = verdict(missing)
         v = self.verdict
         self.hw.note("post_verdict", verdict=v, run=self.post_runs)
         if v.verdict == "HALTED":
@@ -79,7 +82,7 @@ class MCP(PostMaster, Runtime, McpSkeleton):
             self.halted = True
             self.tell("operator", lcd_lines("POST HALTED", names_line("MISSING ", v.missing)), SscMessage.MALFUNCTION)
             if again and self.present("MMC"):
-                self.request(ADDRESS_OF["MMC"], M.MoveRelayed(address=self.address, mov_cmd=int(Direction.STOP), param=0))
+                self.request(ADDRESS_OF["MMC"], M.MoveRelayed(address=self.address, mov_cmd=int(MovCmd.STOP), param=0))
             return
         self.halted = False
         second = names_line("MISSING ", v.missing) if v.missing else "READY"
@@ -100,7 +103,7 @@ class MCP(PostMaster, Runtime, McpSkeleton):
 
     def on_post_req(self, src: int, msg: M.PostReq) -> None:
         """seed 6.3: POST can be started at any time from the UIC/RCP."""
-        if self.post_missing is None:
+        if not self._scheduled(src, msg) or self.post_missing is None:
             return                      # one is running
         self.hw.note("post_requested", by=NODES[src].short if src in NODES else src)
         self.run_post(self.post_done)
@@ -120,28 +123,41 @@ class MCP(PostMaster, Runtime, McpSkeleton):
         ranks = self.net.requesters.get(self.master_bus, ())
         src = min(self.requests, key=lambda a: ranks.index(a) if a in ranks else len(ranks))
         self.requests.remove(src)
-        self.request(src, M.XmitGrant(), (M.Move, M.XmitRecord, M.PostReq), self._record, self._served,
-                     priority=PRIORITY_GRANT)
+        self.fetching = src
+        self.request(src, M.XmitGrant(), _RECORDS, self._record, self._served, priority=PRIORITY_GRANT)
 
     def _served(self) -> None:
         self.serving = False
+        self.fetching = None
         self._serve()
 
     def _record(self, src: int, msg: M.Message) -> None:
-        if isinstance(msg, M.Move):
-            if not self.halted:         # seed 3.2.2: a halted robot stays stopped
-                # relayed before the next grant, like a record (the arbitration model's deliver step; at priority
-                # 0 a steady flow of the SPU's records kept an NP3 MOVE from the MMC: tracecheck's K bound)
-                self.relay_move(src, msg.mov_cmd, msg.param, 1 + self.net.protocol.move_retries, PRIORITY_RELAY)
-        elif isinstance(msg, M.PostReq):
-            self.on_post_req(src, msg)
-        elif isinstance(msg, M.XmitRecord) and msg.target == ADDRESS_OF["NP3"]:
+        """The granted slave's record goes to its generated on_ hook (on_move, on_xmit_record, on_post_req)."""
+        self._handlers[type(msg)](src, msg)
+        self._served()
+
+    def _scheduled(self, src: int, msg: M.Message) -> bool:
+        """seed 3.2.2: a record counts only as the answer to this MCP's XMIT_GRANT; one sent unasked is noted."""
+        if src == self.fetching:
+            return True
+        self.hw.note("record_unasked", message=msg.NAME, src=NODES[src].short if src in NODES else src)
+        return False
+
+    def on_move(self, src: int, msg: M.Move) -> None:
+        """seed 3.2.3/3.2.4: the NP3's (or the RCP's) MOVE goes on to the MMC as MOVE_RELAYED."""
+        if self._scheduled(src, msg) and not self.halted:    # seed 3.2.2: a halted robot stays stopped
+            # relayed before the next grant, like a record (the arbitration model's deliver step; at priority
+            # 0 a steady flow of the SPU's records kept an NP3 MOVE from the MMC: tracecheck's K bound)
+            self.relay_move(src, msg.mov_cmd, msg.param, 1 + self.net.protocol.move_retries, PRIORITY_RELAY)
+
+    def on_xmit_record(self, src: int, msg: M.XmitRecord) -> None:
+        """seed 3.2.2: a slave's record goes to its target as DATA (spec XMIT_RECORD relayed_as)."""
+        if self._scheduled(src, msg) and msg.target == ADDRESS_OF["NP3"]:
             self.counts["records"] += 1
             self.reflex(msg)
             self.request(msg.target, M.Data(address=msg.source, kind=msg.kind, channel=msg.channel, value=msg.value),
                          priority=PRIORITY_RELAY)
             self.supervise(msg)
-        self._served()
 
     def reflex(self, rec: M.XmitRecord) -> None:
         """seed 5.2, spec reflexes: a contact record passing through stops the legs at once, before the NP3 (which
@@ -150,7 +166,7 @@ class MCP(PostMaster, Runtime, McpSkeleton):
         if r is None or r.actor != self.address or not rec.value or rec.kind == _STATUS or self.halted:
             return
         self.hw.note("reflex", source=NODES[rec.source].short if rec.source in NODES else rec.source, command=r.command)
-        self.relay_move(rec.source, int(Direction[r.command]), 0, 1 + self.net.protocol.move_retries, PRIORITY_REFLEX)
+        self.relay_move(rec.source, int(MovCmd[r.command]), 0, 1 + self.net.protocol.move_retries, PRIORITY_REFLEX)
 
     def relay_move(self, src: int, mov_cmd: int, param: int, attempts: int, priority: int = 0) -> None:
         """MOVE_RELAYED has no reply of its own: the MMC's STATUS_ACK (gait, direction) confirms it.

@@ -53,7 +53,7 @@ class MMC(PostMaster, Runtime, MmcSkeleton):
     def start(self) -> None:
         g = self.cfg.geometry
         # the LCPs on the leg bus, by leg number (spec nodes: leg)
-        self.lcps = {self.net.leg_of(a): a for a in slaves_of(self.master_bus) if NODES[a].role == "LCP"}
+        self.lcps = {NODES[a].leg: a for a in slaves_of(self.master_bus) if NODES[a].role == "LCP"}
         self.gait = Gait(g)
         self.errors: dict[int, int] = {}          # leg -> MMC_ERROR
         self.dead: set[int] = set()               # legs whose LCP does not answer

@@ -1,10 +1,10 @@
 """Spec rules the behaviours need that the generated package does not carry yet.
 
-Wire facts (addresses, routes, bus baud rates and timeouts, message classes)
-come from the generated `arachnae_proto`. The `protocol`, `arbitration` and
-`post` sections of spec/nodes.yaml and each node's leg/joint are not in it
-(yet), so the host builds this object from the loaded spec and hands it to
-every behaviour; behaviours never import the spec loader, and never import
+Wire facts (addresses, routes, bus baud rates and timeouts, message classes),
+each node's leg/joint and the POST rule (`arachnae_proto.network.POST`) come
+from the generated `arachnae_proto`. The `protocol`, `arbitration` and
+`reflexes` sections of spec/nodes.yaml are not in it (yet), so the host builds
+this object from the loaded spec and hands it to every behaviour; behaviours never import the spec loader, and never import
 the simulator (firmware logic, issue 5).
 """
 from __future__ import annotations
@@ -32,16 +32,6 @@ class Protocol:
 
 
 @dataclass(frozen=True)
-class Quorum:
-    """seed 6.3: at least `min_complete` units (nodes sharing `unit_key`) with every member present."""
-
-    name: str
-    unit_key: str
-    unit_roles: tuple[str, ...]
-    min_complete: int
-
-
-@dataclass(frozen=True)
 class Reflex:
     """nodes.yaml `reflexes` (seed 5.2): records from `source` make `actor` send `command` to `to` at once."""
 
@@ -60,9 +50,6 @@ class NetConfig:
     backoff_scope: str | None              # 'all' | 'colliders' (who defers after a collision); None: no such rule
     requesters: dict[str, tuple[int, ...]]  # bus -> addresses of the slaves sending its request_message, in rank order
     request_opcodes: dict[str, int]        # bus -> opcode of its request_message (a window slot, not a pause)
-    inactive_statuses: tuple[str, ...]     # seed 6.3: a node reporting one of these counts as missing
-    quorums: tuple[Quorum, ...]
-    units: dict[int, dict[str, int]]       # address -> {'leg': n, 'joint': m} where the spec gives them
     reflexes: tuple["Reflex", ...] = ()    # seed 5.2: fast reactions low in the hierarchy
     reflex_lead_bits: int = 0              # an ordinary request waits this many bit times longer than a reflex one
 
@@ -70,11 +57,6 @@ class NetConfig:
         """The reflex whose records come from node `source`, if any."""
         return next((r for r in self.reflexes if r.source == source), None)
 
-    def leg_of(self, address: int) -> int | None:
-        return self.units.get(address, {}).get("leg")
-
-    def joint_of(self, address: int) -> int | None:
-        return self.units.get(address, {}).get("joint")
 
     @classmethod
     def from_spec(cls, spec: Any) -> "NetConfig":
@@ -103,10 +85,6 @@ class NetConfig:
             reflex_lead_bits=int(backoff["reflex_lead_bits"]) if backoff else 0,
             request_opcodes={name: spec.message(b.request_message).opcode
                              for name, b in spec.buses.items() if b.request_message},
-            inactive_statuses=tuple(spec.post.inactive_statuses),
-            quorums=tuple(Quorum(q.name, q.unit_key, tuple(q.unit_roles), int(q.min_complete)) for q in spec.post.quorums),
-            units={n.address: {k: v for k, v in (("leg", n.leg), ("joint", n.joint)) if v is not None}
-                   for n in spec.nodes if n.leg is not None or n.joint is not None},
         )
 
 

@@ -9,9 +9,8 @@ from dataclasses import dataclass
 from typing import Callable
 
 from arachnae_proto import messages as M
-from arachnae_proto.network import NODES
+from arachnae_proto.network import NODES, POST, PostTable
 
-from behaviours.netconfig import NetConfig
 from behaviours.runtime import slaves_of
 
 _STATUS_REPLIES = (M.StatusAckOrder, M.StatusAckRange, M.StatusAckMmc)
@@ -34,17 +33,17 @@ def behind(address: int) -> list[int]:
     return out
 
 
-def verdict(net: NetConfig, missing_addresses: list[int]) -> Verdict:
+def verdict(missing_addresses: list[int], post: PostTable = POST) -> Verdict:
     """HALTED when a required node outside every quorum or a quorum's minimum is lost,
-    DEGRADED when an optional node or a quorum member is lost, else OPERATIONAL."""
+    DEGRADED when an optional node or a quorum member is lost, else OPERATIONAL (spec post, generated)."""
     missing = {a for a in missing_addresses if a in NODES}
     halted: list[str] = []
     degraded: list[str] = []
     in_quorum: set[int] = set()
-    for q in net.quorums:
+    for q in post.quorums:
         units: dict[int, list[int]] = {}
         for a, node in NODES.items():
-            key = net.units.get(a, {}).get(q.unit_key)
+            key = getattr(node, q.unit_key)            # spec post.quorums.unit_key: a NodeInfo field (leg)
             if node.role in q.unit_roles and key is not None:
                 units.setdefault(key, []).append(a)
                 in_quorum.add(a)
@@ -85,7 +84,7 @@ class PostMaster:
         inactive = set()
         for cls in (M.StatusAckOrder, M.StatusAckRange):
             enum = cls.FIELDS[0].enum
-            inactive |= {(cls, int(enum[s])) for s in self.net.inactive_statuses if s in enum.__members__}  # type: ignore[attr-defined]
+            inactive |= {(cls, int(enum[s])) for s in POST.inactive_statuses if s in enum.__members__}  # type: ignore[attr-defined]
 
         def lost(a: int) -> None:
             missing.append(a)

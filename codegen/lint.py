@@ -20,7 +20,7 @@ import yaml
 from arachnae.errors import UserError, located
 from codegen.encoding import Linear, Log10, to_fraction
 from codegen.generate import LANGUAGES
-from codegen.model import Checksum, Spec
+from codegen.model import Checksum, Spec, enum_values_of
 from arachnae.yamlio import line_of, load_yaml
 
 SCHEMA_DIR = Path(__file__).resolve().parent / "schema"
@@ -180,6 +180,9 @@ def _lint_nodes(path: Path, doc: dict, report: Report) -> set[str]:
             report.add(path, doc, at, f"bus {name}: its master {b['master']} does not declare `masters: {name}`")
         if b["arbitration"] not in doc["arbitration"]:
             report.add(path, doc, at, f"bus {name}: unknown arbitration rule '{b['arbitration']}'")
+    for name, line in doc.get("lines", {}).items():
+        if line["node"] not in shorts:
+            report.add(path, doc, ["lines", name, "node"], f"line {name}: unknown node '{line['node']}'")
     roles = {n["role"] for n in doc["nodes"]}
     for i, q in enumerate(doc["post"]["quorums"]):
         for role in q["unit_roles"]:
@@ -198,6 +201,8 @@ def _lint_request_messages(path: Path, doc: dict, messages_doc: dict, report: Re
     for bus, b in doc["buses"].items():
         name = b.get("request_message")
         if name is None:
+            if "fetch_message" in b:
+                report.add(path, doc, ["buses", bus, "fetch_message"], f"bus {bus}: fetch_message without a request_message")
             continue
         m = by_name.get(name)
         if m is None:
@@ -211,13 +216,32 @@ def _lint_request_messages(path: Path, doc: dict, messages_doc: dict, report: Re
         for i, short in enumerate(b.get("priority", [])):
             if short not in senders:
                 report.add(path, doc, ["buses", bus, "priority", i], f"bus {bus}: priority names {short}, which does not send {name} on it")
+        _lint_fetch(path, doc, bus, b, master_role[b["master"]], slave_roles & set(m["from"]), by_name, report)
+
+
+def _lint_fetch(path: Path, doc: dict, bus: str, b: dict, master: str, requesters: set[str], by_name: dict,
+                report: Report) -> None:
+    """seed 3.2.2: the master fetches the record of the request it serves with the bus's fetch_message, and each
+    requesting role has a record (`record: true`) for the master: the models and the trace checker rely on both."""
+    at = ["buses", bus, "fetch_message"]
+    fetch = by_name.get(b.get("fetch_message", ""))
+    if "fetch_message" not in b:
+        report.add(path, doc, ["buses", bus], f"bus {bus}: a bus with a request_message needs a fetch_message")
+    elif fetch is None:
+        report.add(path, doc, at, f"bus {bus}: fetch_message unknown message '{b['fetch_message']}'")
+    elif master not in fetch["from"] or not requesters <= set(fetch["to"]):
+        report.add(path, doc, at, f"bus {bus}: {fetch['name']} is not sent by {b['master']} to every role that requests the line")
+    for role in sorted(requesters):
+        if not any(m.get("record") and role in m["from"] and master in m["to"] for m in by_name.values()):
+            report.add(path, doc, ["buses", bus, "request_message"],
+                       f"bus {bus}: {role} requests the line but sends {b['master']} no message with `record: true`")
 
 
 def _lint_reflexes(path: Path, doc: dict, messages_doc: dict, report: Report) -> None:
     """A reflex's source, actor and target are nodes; the actor sends the message to the target (seed 5.2)."""
     by_short = {n["short"]: n for n in doc["nodes"]}
     by_name = {m["name"]: m for m in messages_doc["messages"]}
-    enum_values = {k: set(v["values"]) for k, v in messages_doc["enums"].items()}
+    enum_values = {k: set(enum_values_of(messages_doc, k)) for k in messages_doc["enums"]}
     for i, r in enumerate(doc.get("reflexes", [])):
         at = ["reflexes", i]
         missing = [k for k in ("source", "actor", "to") if r[k] not in by_short]
@@ -235,8 +259,11 @@ def _lint_reflexes(path: Path, doc: dict, messages_doc: dict, report: Report) ->
 # -- messages -------------------------------------------------------------------
 def _lint_messages(path: Path, doc: dict, nodes_doc: dict, roles: set[str], report: Report, check_routes: bool) -> None:
     _lint_checksum(path, doc, report)
+    _lint_enum_subsets(path, doc, report)
     for kind, key in (("enums", "values"), ("flags", "bits")):
         for name, e in doc[kind].items():
+            if key not in e:
+                continue                  # a subset: its values are its parent's
             values = list(e[key].values())
             if len(set(values)) != len(values):
                 report.add(path, doc, [kind, name], f"{name}: two names share one value")
@@ -250,6 +277,11 @@ def _lint_messages(path: Path, doc: dict, nodes_doc: dict, roles: set[str], repo
     for i, m in enumerate(doc["messages"]):
         if "relayed_as" in m and m["relayed_as"] not in names:
             report.add(path, doc, ["messages", i, "relayed_as"], f"{m['name']}: relayed_as unknown message '{m['relayed_as']}'")
+        elif "relayed_as" in m and not m.get("record"):
+            report.add(path, doc, ["messages", i, "relayed_as"], f"{m['name']}: relayed_as is for records (`record: true`)")
+        if m.get("record") and (len(m["to"]) != 1 or m.get("broadcast")):
+            report.add(path, doc, ["messages", i, "record"], f"{m['name']}: a record goes to one master role, not {'/'.join(m['to'])}"
+                       f"{' or a broadcast' if m.get('broadcast') else ''}")
 
     for i, m in enumerate(doc["messages"]):
         at = ["messages", i]
@@ -267,6 +299,28 @@ def _lint_messages(path: Path, doc: dict, nodes_doc: dict, roles: set[str], repo
         _lint_fields(path, doc, at, m, max_payload, report)
         if check_routes and all(r in roles for r in m["from"] + m["to"]):
             _lint_routes(path, doc, at, m, nodes_doc, report)
+
+
+def _lint_enum_subsets(path: Path, doc: dict, report: Report) -> None:
+    """An enum has its own `values`, or is `subset_of` an enum with values and names some of them."""
+    for name, e in doc["enums"].items():
+        at = ["enums", name]
+        if ("values" in e) == ("subset_of" in e):
+            report.add(path, doc, at, f"{name}: needs either `values` or `subset_of` with `names`")
+        elif "subset_of" in e:
+            parent = doc["enums"].get(e["subset_of"])
+            if "names" not in e:
+                report.add(path, doc, at, f"{name}: `subset_of` needs `names`")
+            elif parent is None or "values" not in parent:
+                report.add(path, doc, at + ["subset_of"], f"{name}: subset_of '{e['subset_of']}' is no enum with its own values")
+            else:
+                for j, n in enumerate(e["names"]):
+                    if n not in parent["values"]:
+                        report.add(path, doc, at + ["names", j], f"{name}: {n} is not a value of {e['subset_of']}")
+            if "texts" in e:
+                report.add(path, doc, at + ["texts"], f"{name}: a subset takes its texts from nowhere; declare them on {e['subset_of']}")
+        elif "names" in e:
+            report.add(path, doc, at + ["names"], f"{name}: `names` belongs with `subset_of`")
 
 
 def _lint_checksum(path: Path, doc: dict, report: Report) -> None:
@@ -340,7 +394,8 @@ def _lint_enum_ref(path: Path, doc: dict, fat: list, fname: str, f: dict, key: s
     elif ref not in doc[table]:
         report.add(path, doc, fat + [key], f"{fname}: unknown {key} '{ref}'")
     else:
-        biggest = max(doc[table][ref][values_key].values())
+        biggest = max(enum_values_of(doc, ref).values() if table == "enums" else doc[table][ref][values_key].values(),
+                      default=0)
         if biggest >= 1 << bits:
             report.add(path, doc, fat, f"{fname}: {key} {ref} has value {biggest}, wider than {bits} bits")
 

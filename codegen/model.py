@@ -7,6 +7,7 @@ may assume a consistent network.
 from __future__ import annotations
 
 import hashlib
+import math
 from dataclasses import dataclass, field
 from fractions import Fraction
 from functools import cached_property
@@ -45,6 +46,7 @@ class Node:
     section: str
     leg: int | None = None
     joint: int | None = None
+    absent: str | None = None  # a function of the node the toolkit does not implement, and why (spec nodes.absent)
 
     @property
     def ident(self) -> str:
@@ -73,6 +75,7 @@ class Bus:
     slaves: tuple[str, ...] = ()
     request_message: str | None = None   # what a slave sends to ask for the line (None: polled bus)
     priority: tuple[str, ...] = ()       # slaves ranked first in arbitration, in order (rank_order: declared_priority)
+    fetch_message: str | None = None     # what the master sends to fetch a served request's record
 
     @property
     def char_time_us(self) -> float:
@@ -90,6 +93,25 @@ class Bus:
     def frame_gap_us(self) -> float:
         """Least idle time before any frame may start: the turnaround, and the gap that delimits frames."""
         return max(self.turnaround_us, self.idle_gap_us)
+
+
+@dataclass(frozen=True)
+class Line:
+    """A serial line off the RS-485 buses (nodes.yaml `lines`), e.g. the UIC/RCP's RS-232C terminal line (4.1)."""
+
+    name: str
+    long: str
+    node: str                 # the node whose line it is
+    baud: int
+    data_bits: int
+    parity: str               # 'none' | 'even' | 'odd' | 'mark' | 'space'
+    stop_bits: float
+    section: str
+
+    @property
+    def bits_per_char(self) -> int:
+        """Start bit, data bits, parity bit, stop bits (1.5 stop bits count as 2 here)."""
+        return 1 + self.data_bits + (self.parity != "none") + math.ceil(self.stop_bits)
 
 
 @dataclass(frozen=True)
@@ -156,6 +178,17 @@ class Enum:
     values: dict[str, int]
     section: str
     texts: dict[str, str] = field(default_factory=dict)
+    subset_of: str | None = None      # a part of that enum (GAIT, DIRECTION of MOV_CMD): its codes are declared there
+
+
+def enum_values_of(messages_doc: dict, name: str) -> dict[str, int]:
+    """messages.yaml enum `name`'s values: its own, or for a `subset_of` one its names' values in the parent
+    ({} for what does not resolve; codegen.lint reports that)."""
+    e = messages_doc["enums"].get(name, {})
+    if "values" in e:
+        return dict(e["values"])
+    parent = messages_doc["enums"].get(e.get("subset_of", ""), {}).get("values", {})
+    return {n: parent[n] for n in e.get("names", ()) if n in parent}
 
 
 @dataclass(frozen=True)
@@ -238,6 +271,7 @@ class Message:
     doc: str
     fields: tuple[Field, ...]
     relayed_as: str | None = None   # the MCP delivers this record to its target as that message
+    record: bool = False            # a slave's record: what it hands its master when fetched (seed 3.2.2)
 
     @property
     def fixed_size(self) -> int:
@@ -344,6 +378,7 @@ class Spec:
     hash: str                 # sha256 of the spec files, hex
     reflexes: tuple[Reflex, ...] = ()
     requirements: dict[str, Requirement] = field(default_factory=dict)
+    lines: dict[str, Line] = field(default_factory=dict)
 
     # -- lookups -------------------------------------------------------------
     @cached_property
@@ -410,6 +445,11 @@ class Spec:
             first = [self.node(s) for s in b.priority]
             return first + [n for n in nodes if n.short not in b.priority]
         return nodes
+
+    def records(self, role: str, master_role: str) -> list[Message]:
+        """The records (`record: true`) a `role` hands a master of `master_role` when fetched, longest first."""
+        return sorted((m for m in self.messages if m.record and role in m.senders and master_role in m.receivers),
+                      key=lambda m: -m.max_size)
 
     def requirement(self, name: str) -> Requirement | None:
         return self.requirements.get(name)
@@ -497,7 +537,7 @@ def build(nodes_doc: dict, messages_doc: dict, sources: tuple[Path, ...], digest
     nodes = tuple(
         Node(short=n["short"], long=n["long"], address=n["address"], level=n["level"], role=n["role"],
              bus=n["bus"], masters=n.get("masters"), status=n["status"], section=n["section"],
-             leg=n.get("leg"), joint=n.get("joint"))
+             leg=n.get("leg"), joint=n.get("joint"), absent=n.get("absent"))
         for n in nodes_doc["nodes"]
     )
     buses = {
@@ -506,7 +546,7 @@ def build(nodes_doc: dict, messages_doc: dict, sources: tuple[Path, ...], digest
                   idle_gap_chars=b["idle_gap_chars"], response_timeout_ms=b["response_timeout_ms"],
                   id_retries=b["id_retries"], arbitration=b["arbitration"], section=b["section"],
                   slaves=tuple(n.short for n in nodes if n.bus == name), request_message=b.get("request_message"),
-                  priority=tuple(b.get("priority", ())))
+                  priority=tuple(b.get("priority", ())), fetch_message=b.get("fetch_message"))
         for name, b in nodes_doc["buses"].items()
     }
     post_doc = nodes_doc["post"]
@@ -523,13 +563,15 @@ def build(nodes_doc: dict, messages_doc: dict, sources: tuple[Path, ...], digest
                   Checksum(c["name"], c["width"], c["poly"], c["init"], c["refin"], c["refout"], c["xorout"], c["check"]),
                   fdoc["section"], byte_order=fdoc["byte_order"], covers=tuple(c["covers"]),
                   pcap_linktype=fdoc["pcap_linktype"])
-    enums = {k: Enum(k, dict(v["values"]), v["section"], dict(v.get("texts", {}))) for k, v in messages_doc["enums"].items()}
+    enums = {k: Enum(k, enum_values_of(messages_doc, k), v["section"], dict(v.get("texts", {})), v.get("subset_of"))
+             for k, v in messages_doc["enums"].items()}
     flags = {k: Flags(k, dict(v["bits"]), v["section"]) for k, v in messages_doc["flags"].items()}
     messages = tuple(
         Message(name=m["name"], seed_name=m.get("seed_name", m["name"]), opcode=m["opcode"], section=m["section"],
                 origin=m.get("origin", "seed"), broadcast=bool(m.get("broadcast", False)),
                 senders=tuple(m["from"]), receivers=tuple(m["to"]), doc=m["doc"],
-                fields=_fields(m.get("fields", []), enums, flags, fdoc["max_payload"]), relayed_as=m.get("relayed_as"))
+                fields=_fields(m.get("fields", []), enums, flags, fdoc["max_payload"]), relayed_as=m.get("relayed_as"),
+                record=bool(m.get("record", False)))
         for m in messages_doc["messages"]
     )
     p = nodes_doc["protocol"]
@@ -541,7 +583,9 @@ def build(nodes_doc: dict, messages_doc: dict, sources: tuple[Path, ...], digest
                 reflexes=tuple(Reflex(r["name"], r["source"], r["actor"], r["to"], r["message"], r["command"],
                                       r["min_interval_ms"], r["section"], r["origin"]) for r in nodes_doc.get("reflexes", [])),
                 requirements={q["name"]: Requirement(q["name"], q["bound_ms"], q["rule"], q["section"])
-                              for q in nodes_doc.get("requirements", [])})
+                              for q in nodes_doc.get("requirements", [])},
+                lines={k: Line(k, v["long"], v["node"], v["baud"], v["data_bits"], v["parity"], v["stop_bits"], v["section"])
+                       for k, v in nodes_doc.get("lines", {}).items()})
 
 
 def spec_digest(paths: tuple[Path, ...]) -> str:
@@ -551,5 +595,5 @@ def spec_digest(paths: tuple[Path, ...]) -> str:
     return h.hexdigest()
 
 
-__all__ = ["ERROR_KINDS", "Spec", "Node", "Bus", "Message", "Field", "Enum", "Flags", "Frame", "Checksum", "PostRule", "PostRules", "Protocol",
-           "Quorum", "Reflex", "Requirement", "SPEC_DIR", "SPEC_FILES", "MILLI", "build", "spec_digest"]
+__all__ = ["ERROR_KINDS", "Spec", "Node", "Bus", "Line", "Message", "Field", "Enum", "Flags", "Frame", "Checksum", "PostRule", "PostRules", "Protocol",
+           "Quorum", "Reflex", "Requirement", "SPEC_DIR", "SPEC_FILES", "MILLI", "build", "enum_values_of", "spec_digest"]

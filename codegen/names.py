@@ -77,6 +77,8 @@ def of_enum(e: Enum | Flags, member: str | None = None) -> Origin:
     table, values = ("enums", "values") if isinstance(e, Enum) else ("flags", "bits")
     if member is None:
         return Origin("messages", (table, e.name), f"{table[:-1]} {e.name}")
+    if isinstance(e, Enum) and e.subset_of:        # a subset names its members in a list (spec enums.<E>.names)
+        return Origin("messages", (table, e.name, "names", list(e.values).index(member)), f"{table[:-1]} {e.name}.{member}")
     return Origin("messages", (table, e.name, values, member), f"{table[:-1]} {e.name}.{member}")
 
 

@@ -15,6 +15,12 @@ import termios
 import tty
 from typing import Protocol
 
+from arachnae_proto.network import LINES, SerialLine
+
+# seed 4.1: the RCP's RS-232C line; its settings are the spec's (nodes.yaml lines.rcp), never restated here
+RCP_LINE = LINES["rcp"]
+_PARITY = {"none": "N", "even": "E", "odd": "O", "mark": "M", "space": "S"}   # pyserial's parity letters
+
 
 class Port(Protocol):
     peer: str | None
@@ -82,10 +88,11 @@ class FdPort:
 class SerialPort:
     """A pyserial port: a real RS-232 port, a pty path, or any `serial_for_url` URL."""
 
-    def __init__(self, url: str, baudrate: int = 9600) -> None:
+    def __init__(self, url: str, line: SerialLine = RCP_LINE) -> None:
         import serial                        # pyserial; only needed for this kind of line
 
-        self.ser = serial.serial_for_url(url, baudrate=baudrate, timeout=0)
+        self.ser = serial.serial_for_url(url, baudrate=line.baud, bytesize=line.data_bits,
+                                         parity=_PARITY[line.parity], stopbits=line.stop_bits, timeout=0)
         self.peer: str | None = url
 
     def read(self, timeout: float = 0.0) -> bytes:
@@ -104,19 +111,36 @@ class SerialPort:
         self.ser.close()
 
 
+def set_line(fd: int, line: SerialLine) -> None:
+    """Give a tty the line's speed and character framing (a pty only records them; a real port uses them)."""
+    speed = getattr(termios, f"B{line.baud}", None)
+    if speed is None:
+        raise ValueError(f"spec lines: {line.baud} baud is no termios speed")
+    attrs = termios.tcgetattr(fd)
+    cflag = attrs[2] & ~(termios.CSIZE | termios.PARENB | termios.PARODD | termios.CSTOPB)
+    cflag |= getattr(termios, f"CS{line.data_bits}")
+    if line.parity != "none":
+        cflag |= termios.PARENB | (termios.PARODD if line.parity in ("odd", "mark") else 0)
+    if line.stop_bits > 1:
+        cflag |= termios.CSTOPB
+    attrs[2], attrs[4], attrs[5] = cflag, speed, speed
+    termios.tcsetattr(fd, termios.TCSANOW, attrs)
+
+
 def open_pty() -> tuple[FdPort, int]:
     """A line whose far end is a new pseudo-terminal; returns it and the fd of the terminal's side."""
     import pty
 
     master, slave = pty.openpty()
     tty.setraw(slave)                        # the terminal side: no echo, no line editing
+    set_line(slave, RCP_LINE)                # what `stty -F` shows a terminal program: the spec's line
     os.set_blocking(master, False)           # a full pty buffer must not block the simulation
     port = FdPort(master, raw=False, owns=(master,), write_timeout=0.1)
     port.peer = os.ttyname(slave)
     return port, slave
 
 
-def attach(where: str = "pty", baudrate: int = 9600) -> Port:
+def attach(where: str = "pty", line: SerialLine = RCP_LINE) -> Port:
     """The RCP line for a running simulation.
 
     where = "stdio": the terminal the process runs in (raw mode; restored by close());
@@ -130,4 +154,4 @@ def attach(where: str = "pty", baudrate: int = 9600) -> Port:
         port, slave = open_pty()
         port.owns = port.owns + (slave,)    # keep the device open while nobody has it open yet
         return port
-    return SerialPort(where.removeprefix("serial:"), baudrate)
+    return SerialPort(where.removeprefix("serial:"), line)

@@ -76,15 +76,18 @@ def role_config(spec, role: str) -> str:
         ]
         lines += slave_timing(net, node, t, rank)
     else:
-        lines += ["#define FW_BAUD 9600UL", "#define FW_BITS_PER_CHAR 10u", "#define FW_CHAR_US 1042UL",
-                  "#define FW_TURNAROUND_US 500UL", "#define FW_IDLE_GAP_US 3646UL",
+        own = spec.buses[node.masters]    # the MCP is no slave: the line it runs is the bus it masters
+        lines += [f"/* bus {own.name} (mastered), seed {own.section} */", f"#define FW_BAUD {own.baud}UL",
+                  f"#define FW_BITS_PER_CHAR {own.bits_per_char}u", f"#define FW_CHAR_US {round(own.char_time_us)}UL",
+                  f"#define FW_TURNAROUND_US {round(own.turnaround_us)}UL",
+                  f"#define FW_IDLE_GAP_US {round(own.idle_gap_us)}UL /* {own.idle_gap_chars} characters */",
                   "#define FW_MASTER_ADDRESS 0x00u", "#define FW_BACKOFF_RANK 0u", "#define FW_BACKOFF_SLOT_US 0UL",
                   "#define FW_QUIET_AFTER_MASTER_US 0UL", "#define FW_QUIET_AFTER_OTHER_US 0UL",
                   "#define FW_QUIET_IN_WINDOW_US 0UL", "#define FW_REQUEST_OPCODE 0x00u", "#define FW_BACKOFF_SCOPE_ALL 0u", "#define FW_BACKOFF_STEP_US 0UL",
                   "#define FW_REQUESTERS 0u"]
     lines += tuning(role) + alarm_limit(role)
     tx_max = spec.frame.overhead + max((m.max_size for m in spec.sends(role)), default=0)
-    char_us = spec.buses[node.bus].char_time_us if node.bus else 1e6 * 10 / 9600
+    char_us = spec.buses[node.bus or node.masters].char_time_us
     low = role.lower()
     lines += [
         "#ifndef FW_BASELINE  /* the hand-written baseline uses no generated code */",

@@ -63,11 +63,14 @@ def receiver_of(spec, message: str):
 
 
 def data_record(spec, role: str):
-    """The XMIT_DATA form a sensor role answers with (seed 3.2.11: XMIT_DATA in each node's encoding)."""
-    record = next((m for m in spec.messages if m.senders == (role,) and m.seed_name == "XMIT_DATA"), None)
-    if record is None:
-        raise UserError(f"{spec.sources[-1]}: no XMIT_DATA form (seed_name XMIT_DATA) sent by {role}")
-    return record
+    """The record a sensor role answers its master's fetch with (seed 3.2.11: XMIT_DATA in each node's encoding;
+    spec messages.<m>.record)."""
+    bus = spec.role_nodes(role)[0].bus if spec.role_nodes(role) else None
+    master = spec.node(spec.buses[bus].master).role if bus else None
+    records = spec.records(role, master) if master else []
+    if not records:
+        raise UserError(f"{spec.sources[-1]}: {role} sends its master no message with `record: true`")
+    return records[0]
 
 
 def frame_us(spec, bus: str, message: str) -> float:
@@ -127,27 +130,22 @@ def request_message(spec, bus: str) -> str:
 
 
 def record_route(spec, bus: str, slave) -> tuple[list[str], list[str], str]:
-    """Adapter: frames fetching a slave's record and relaying it, and the record's target node."""
+    """Adapter: frames fetching a slave's record and relaying it, and the record's target node.
+
+    seed 3.2.2: the master fetches with the bus's fetch_message; the slave's longest record (spec
+    `record: true`) answers; a record with `relayed_as` goes on to the node of the bus that receives that."""
     b = spec.buses[bus]
     master = spec.node(b.master)
-    role = slave.role
     fetch, relay, target = [], [], master.short
-    for name in ("XMIT_GRANT", "XMIT_DATA"):
-        try:
-            m = spec.message(name)
-        except KeyError:
-            continue
-        if master.role in m.senders and role in m.receivers:
-            fetch.append(name)
-            break
-    record = next((m for m in spec.messages
-                   if role in m.senders and m.receivers == (master.role,) and m.name in ("XMIT_RECORD", "MOVE")),
-                  None)
-    if record is None:
-        record = data_record(spec, role)
+    if b.fetch_message is not None:
+        fetch.append(b.fetch_message)
+    records = spec.records(slave.role, master.role)
+    if not records:
+        raise UserError(f"{spec.sources[-1]}: {slave.role} sends {master.short} no message with `record: true`")
+    record = records[0]
     fetch.append(record.name)
-    if record.name != "XMIT_DATA" and record.seed_name != "XMIT_DATA":
-        relayed = spec.message(record.relayed_as or "DATA")   # spec messages.<record>.relayed_as
+    if record.relayed_as is not None:         # spec messages.<record>.relayed_as
+        relayed = spec.message(record.relayed_as)
         dest = next((n for n in spec.nodes if n.bus == bus and n.role in relayed.receivers), None)
         if dest is not None:
             relay.append(relayed.name)

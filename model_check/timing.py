@@ -86,7 +86,8 @@ def scan_duration(spec, measurements: int = 3, step_deg: int = 1, range_m: float
     echo = 2 * range_m / SPEED_OF_SOUND
     sonar = sa.receiver_of(spec, "HEAD_STEP")     # seed 3.2.11: the USRC turns the head and measures
     frames_us = sum(sa.frame_us(spec, sonar.bus, m)
-                    for m in ("HEAD_STEP", "DO_MEASURE", "XMIT_DATA", sa.data_record(spec, sonar.role).name))
+                    for m in ("HEAD_STEP", "DO_MEASURE", spec.buses[sonar.bus].fetch_message,  # spec buses.<b>.fetch_message
+                              sa.data_record(spec, sonar.role).name))
     per_step = measurements * echo + frames_us / 1e6
     total = steps * per_step
     parts = [f"{steps} steps x ({measurements} x {echo * 1000:.1f} ms echo at {range_m:g} m "

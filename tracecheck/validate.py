@@ -117,6 +117,14 @@ class Rules:
         self.move_retries = int(spec.protocol.move_retries)
         self.defer_slots = int(spec.protocol.master_defer_slots)
         self.inactive = set(spec.post.inactive_statuses)
+        # seed 3.2.2: the records the MCP relays (spec messages.<m>.record, relayed_as), found by attribute, not name:
+        # a record naming its `target` goes there as its relayed_as; the others (MOVE) to that message's receiver
+        relays = {m.name: m.relayed_as for m in spec.messages if m.record and m.relayed_as}
+        self.targeted = {r: d for r, d in relays.items() if any(f.name == "target" for f in spec.message(r).fields)}
+        self.command_relays: dict[str, set[str]] = {}
+        for r, d in relays.items():
+            if r not in self.targeted:
+                self.command_relays.setdefault(d, set()).add(r)
         self.post = spec_adapter.post(spec)
         self.tree = post_model.Tree(self.post, None)
         proved = bounds(spec)
@@ -551,28 +559,30 @@ class Validator:
         frames = self.by_bus.get(bus, [])
         mcp = self.rules.mcp
         for j, f in enumerate(frames):
-            if f.name == "XMIT_RECORD" and f.intact and self.dst(f) == mcp:
-                m = f.parsed.message
+            if f.name in self.rules.targeted and f.intact and self.dst(f) == mcp:
+                m, relayed = f.parsed.message, self.rules.targeted[f.name]
                 self.report.checked["record_relayed"] += 1
                 want = (m.source, m.kind, m.channel, m.value)
-                ok = any(g.name == "DATA" and self.src(g) == mcp and g.parsed.dst == m.target
+                ok = any(g.name == relayed and self.src(g) == mcp and g.parsed.dst == m.target
                          and (g.parsed.message.address, g.parsed.message.kind, g.parsed.message.channel,
                               g.parsed.message.value) == want for g in frames[j + 1:])
                 if not ok and self.end_t - f.end > 2.0:
                     self.report.add(f, "record_relayed", f"record of {self.rules.short.get(m.source)} from "
                                     f"{self.src(f)} to {self.rules.short.get(m.target)} never relayed by the MCP "
                                     f"(seed 3.2.2: every datum runs through the MCP)")
-        self.move_relays(frames)
+        for relayed, records in self.rules.command_relays.items():
+            self.move_relays(frames, relayed, records)
 
-    def move_relays(self, frames: list[TraceFrame]) -> None:
+    def move_relays(self, frames: list[TraceFrame], relayed: str, records: set[str]) -> None:
+        """Resends of one relayed command (MOVE_RELAYED), a run ended by a new record (MOVE) carrying one."""
         mcp = self.rules.mcp
-        relays = [j for j, f in enumerate(frames) if f.name == "MOVE_RELAYED" and self.src(f) == mcp
+        relays = [j for j, f in enumerate(frames) if f.name == relayed and self.src(f) == mcp
                   and f.parsed.message.address != f.parsed.src]
         run: list[int] = []
         for j in relays + [None]:
             f = frames[j] if j is not None else None
             if run and f is not None and self._same_move(frames[run[-1]], f) and not any(
-                    g.name == "MOVE" and g.intact for g in frames[run[-1] + 1:j]):
+                    g.name in records and g.intact for g in frames[run[-1] + 1:j]):
                 run.append(j)
             else:
                 if run:
@@ -589,7 +599,7 @@ class Validator:
         allowed = 1 + self.rules.move_retries
         if len(run) > allowed:
             f = frames[run[allowed]]
-            self.report.add(f, "move_retries", f"MOVE_RELAYED {f.parsed.message.describe()} sent {len(run)} times, "
+            self.report.add(f, "move_retries", f"{f.name} {f.parsed.message.describe()} sent {len(run)} times, "
                             f"protocol.move_retries allows {self.rules.move_retries} resend(s)")
         for a, b in zip(run, run[1:]):
             if not frames[a].intact:

@@ -202,3 +202,26 @@ def test_no_reflex_for_other_records_or_a_cleared_contact(spec):
     send_record(rig, bus, SPU, record("IRRC", RecordKind.ALARM, 10, 1), 2.5)      # not a reflex source
     rig.run(3.5)
     assert not [f for _t, f in rig.frames(M.MoveRelayed, MMC) if f.message.mov_cmd == int(Direction.STOP)]
+
+
+def test_a_granted_move_goes_through_the_generated_on_move_and_an_unasked_one_is_not_relayed(spec, monkeypatch):
+    """issue 16 item 6: the MCP's MOVE path is the skeleton's on_move hook (seed 3.2.3); seed 3.2.2: a record
+    counts only as the answer to the MCP's grant, so a MOVE the NP3 sends unasked moves nothing."""
+    from behaviours.mcp import MCP as McpNode
+
+    hooked = []
+    relay = McpNode.on_move
+
+    def spy(self, src, msg):
+        hooked.append((src, msg.mov_cmd))
+        relay(self, src, msg)
+    monkeypatch.setattr(McpNode, "on_move", spy)
+    rig, bus = mcp(spec)
+    rig.inject(1.6, NP3, M.Move(mov_cmd=int(Direction.TURN_LEFT), param=0))       # no XMIT_REQ, no grant
+    rig.run(1.9)
+    assert hooked == [(NP3, int(Direction.TURN_LEFT))] and not rig.frames(M.MoveRelayed)
+    assert notes(rig, "record_unasked")
+    send_record(rig, bus, NP3, M.Move(mov_cmd=int(Direction.FORWARD), param=0), 2.0)
+    rig.run(2.5)
+    assert hooked[-1] == (NP3, int(Direction.FORWARD))
+    assert [f.message.mov_cmd for _, f in rig.frames(M.MoveRelayed)][:1] == [int(Direction.FORWARD)]

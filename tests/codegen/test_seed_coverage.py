@@ -100,3 +100,31 @@ def test_post_rule_is_data(spec) -> None:
     legs = spec.post.quorums[0]
     assert (legs.unit_key, legs.unit_roles, legs.min_complete) == ("leg", ("LCP", "JAC"), 5)
     assert spec.post.verdicts == ("OPERATIONAL", "DEGRADED", "HALTED")
+
+
+def test_generated_tables_carry_the_post_rule_units_records_and_lines(spec) -> None:
+    """issue 16 item 3: behaviours read the POST rule, a node's leg/joint, which messages are records and the
+    RCP line from arachnae_proto (named records), generated from the spec, not from a second declaration."""
+    from arachnae_proto import messages as M
+    from arachnae_proto.enums import Direction, Gait, MovCmd
+    from arachnae_proto.network import LINES, NODES, POST
+
+    assert POST.verdicts == spec.post.verdicts and POST.inactive_statuses == spec.post.inactive_statuses
+    assert [(q.name, q.unit_key, q.unit_roles, q.min_complete) for q in POST.quorums] == \
+        [(q.name, q.unit_key, q.unit_roles, q.min_complete) for q in spec.post.quorums]
+    assert all((NODES[n.address].leg, NODES[n.address].joint) == (n.leg, n.joint) for n in spec.nodes)
+    records = {cls.NAME: cls.RELAYED_AS for cls in vars(M).values() if isinstance(cls, type) and getattr(cls, "RECORD", False)}
+    assert records == {m.name: m.relayed_as for m in spec.messages if m.record}
+    assert {"XMIT_RECORD", "MOVE", "POST_REQ"} <= set(records)          # seed 3.2.2: the first-level bus's records
+    rcp = spec.lines["rcp"]
+    assert (LINES["rcp"].baud, LINES["rcp"].data_bits, LINES["rcp"].parity, LINES["rcp"].stop_bits) == \
+        (rcp.baud, rcp.data_bits, rcp.parity, rcp.stop_bits) and LINES["rcp"].node == "UIC/RCP"
+    # seed 3.2.4: the gait and direction codes are MOV_CMD's, declared once (spec enums GAIT/DIRECTION subset_of)
+    assert spec.enums["GAIT"].subset_of == spec.enums["DIRECTION"].subset_of == "MOV_CMD"
+    assert {g.name: int(g) for g in Gait} == {k: int(MovCmd[k]) for k in ("TRIPOD", "RIPPLE", "WAVE")}
+    assert {d.name: int(d) for d in Direction} == {m.name: int(m) for m in MovCmd if m < MovCmd.TRIPOD}
+
+
+def test_what_is_not_implemented_is_declared(spec) -> None:
+    """issue 16 item 6: the RLC's radio host link (seed 3.2.9) is declared absent with its reason, nothing else is."""
+    assert [n.short for n in spec.nodes if n.absent] == ["RLC"] and "3.2.9" in spec.node("RLC").absent

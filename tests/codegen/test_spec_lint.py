@@ -71,6 +71,19 @@ CASES = [
      "reflex whisker_stop: MCP does not send MOVE to MMC"),
     ("reflex_bad_command", N, "    command: STOP\n", "    command: HALT\n", None,
      "reflex whisker_stop: command HALT is no enum value"),
+    # issue 16: records, fetches, enum subsets and serial lines are declared, and checked
+    ("no_fetch_message", N, "request_message: XMIT_REQ, fetch_message: XMIT_GRANT,", "request_message: XMIT_REQ,",
+     None, "bus first: a bus with a request_message needs a fetch_message"),
+    ("fetch_not_to_requesters", N, "fetch_message: XMIT_GRANT,", "fetch_message: XMIT_DATA,", None,
+     "bus first: XMIT_DATA is not sent by MCP to every role that requests the line"),
+    ("relayed_not_a_record", M, "    record: true\n    relayed_as: MOVE_RELAYED", "    relayed_as: MOVE_RELAYED", None,
+     "MOVE: relayed_as is for records (`record: true`)"),
+    ("subset_unknown_name", M, "names: [TRIPOD, RIPPLE, WAVE]", "names: [TRIPOD, RIPPLE, WAVY]", None,
+     "GAIT: WAVY is not a value of MOV_CMD"),
+    ("subset_and_values", M, "    subset_of: MOV_CMD\n    names: [TRIPOD, RIPPLE, WAVE]",
+     "    subset_of: MOV_CMD\n    values: {TRIPOD: 7}\n    names: [TRIPOD, RIPPLE, WAVE]", "  GAIT:\n",
+     "GAIT: needs either `values` or `subset_of` with `names`"),
+    ("line_unknown_node", N, 'node: "UIC/RCP"', 'node: "UIC/RCX"', None, "line rcp: unknown node 'UIC/RCX'"),
 ]
 
 
@@ -125,3 +138,16 @@ def test_missing_spec_file_is_one_line(tmp_path: Path) -> None:
                          capture_output=True, text=True)
     assert run.returncode == 1
     assert run.stderr.strip() == f"{tmp_path / N}: cannot read: No such file or directory"
+
+
+def test_a_requester_without_a_record_is_named_at_its_bus(tmp_path: Path) -> None:
+    """seed 3.2.2: a slave that requests the line must have a record for its master (messages.<m>.record);
+    the problem is the bus's, so nodes.yaml's request_message line is named."""
+    _broken(tmp_path, M, "    record: true\n    relayed_as: DATA", "    relayed_as: DATA")
+    nodes = tmp_path / N
+    with pytest.raises(UserError) as err:
+        load_spec(tmp_path)
+    line = _line_of(nodes, "request_message: XMIT_REQ")
+    for role in ("APU_SDF", "RLC", "SPU"):               # XMIT_RECORD's senders, which send no other record
+        assert f"{nodes}:{line}: bus first: {role} requests the line but sends MCP no message with `record: true`" \
+            in str(err.value).splitlines()

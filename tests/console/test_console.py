@@ -128,3 +128,53 @@ def test_the_firmware_side_does_not_pull_in_the_host_terminal():
     code = "import sys, behaviours.level0; print('console.terminal' in sys.modules, 'termios' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split() == ["False", "False"]
+
+
+def _line_of(fd: int) -> tuple[int, int, bool, bool, bool]:
+    """(speed, CSIZE bits, parity on, odd parity, two stop bits) as termios reports the device."""
+    import termios
+
+    attrs = termios.tcgetattr(fd)
+    c = attrs[2]
+    return attrs[5], c & termios.CSIZE, bool(c & termios.PARENB), bool(c & termios.PARODD), bool(c & termios.CSTOPB)
+
+
+def _expect(line) -> tuple[int, int, bool, bool, bool]:
+    import termios
+
+    return (getattr(termios, f"B{line.baud}"), getattr(termios, f"CS{line.data_bits}"), line.parity != "none",
+            line.parity in ("odd", "mark"), line.stop_bits > 1)
+
+
+def test_both_kinds_of_line_take_the_spec_rcp_settings():
+    """seed 4.1: the RCP line's baud, bits, parity and stop bits are the spec's (nodes.yaml lines.rcp), on the
+    pty a terminal program opens and on a pyserial port; another line's settings are applied as given."""
+    import pty
+
+    from arachnae_proto.network import LINES, SerialLine
+    from console.terminal import set_line
+
+    port = attach("pty")
+    try:
+        fd = os.open(port.peer, os.O_RDWR | os.O_NOCTTY)
+        try:
+            assert _line_of(fd) == _expect(LINES["rcp"])
+        finally:
+            os.close(fd)
+    finally:
+        port.close()
+    master, slave = pty.openpty()
+    other = SerialLine("test", "UIC/RCP", 19200, 8, "none", 2, "4.1")   # a Linux pty keeps speed and stop bits only
+    try:
+        set_line(slave, other)
+        assert _line_of(slave) == _expect(other) != _expect(LINES["rcp"])
+        serial_port = attach("serial:" + os.ttyname(slave))
+        try:
+            assert _line_of(slave) == _expect(LINES["rcp"])
+        finally:
+            serial_port.close()
+        with pytest.raises(ValueError, match="12345 baud"):
+            set_line(slave, other._replace(baud=12345))
+    finally:
+        os.close(master)
+        os.close(slave)

@@ -3,7 +3,7 @@ the first offending frame by time and bus (issue 11, part 1): the proofs reach t
 from __future__ import annotations
 
 import re
-from dataclasses import replace
+from arachnae_proto.network import POST
 
 from behaviours import mcp
 from behaviours.runtime import BusTiming, Runtime
@@ -60,9 +60,9 @@ def test_timeout_mutation_is_caught(monkeypatch, missing_scenario):
 def test_post_quorum_mutation_is_caught(monkeypatch, missing_scenario):
     verdict = mcp.verdict
 
-    def six_legs(net, missing):
-        return verdict(replace(net, quorums=tuple(replace(q, min_complete=q.min_complete + 1)
-                                                   for q in net.quorums)), missing)
+    def six_legs(missing, post=POST):
+        return verdict(missing, post._replace(quorums=tuple(q._replace(min_complete=q.min_complete + 1)
+                                                            for q in post.quorums)))
     monkeypatch.setattr(mcp, "verdict", six_legs)
     out = runner.run(str(missing_scenario))
     t, bus, rule = first(out)
