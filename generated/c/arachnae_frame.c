@@ -93,11 +93,11 @@ arachnae_status arachnae_frame_check(const uint8_t *frame, uint16_t len, uint16_
     return for_us ? ARACHNAE_OK : ARACHNAE_ADDRESS;
 }
 
-/* parser states */
+/* parser states; READY and HELD, the two with a valid frame, are the highest (one compare) */
 #define PS_RECEIVING 0u
 #define PS_COMPLETE 1u  /* frame ended where its length byte said; verdict given */
-#define PS_READY 2u     /* as COMPLETE, and the frame passed every check */
-#define PS_DISCARD 3u   /* error reported; ignore bytes until the gap */
+#define PS_DISCARD 2u   /* error reported; ignore bytes until the gap */
+#define PS_READY 3u     /* as COMPLETE, and the frame passed every check */
 #define PS_HELD 4u      /* READY frame after its gap: kept until the next byte */
 
 void arachnae_parser_init(arachnae_parser *p, uint8_t *buf, uint16_t cap, uint16_t own,
@@ -165,7 +165,7 @@ arachnae_status arachnae_parser_gap(arachnae_parser *p)
 
 const uint8_t *arachnae_parser_frame(const arachnae_parser *p, uint16_t *len)
 {
-    if (p->state != PS_READY && p->state != PS_HELD)
+    if (p->state < PS_READY)   /* neither READY nor HELD */
         return 0;
     *len = p->count;
     return p->buf;

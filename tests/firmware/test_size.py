@@ -11,10 +11,13 @@ import pytest
 from tests.firmware.conftest import FIRMWARE, make
 
 SENSORS = ("usrc", "tpsc", "irrc", "isc", "tsc", "lsc", "psc")
-# What the generated C reaches today, with a little room: a regression past these fails. Issue 15's targets
-# (sensors 1024, TPSC 633 = 1.5x its baseline, any role 2048) are not reached yet; `make size` prints each
-# role against its budget and the issue's note carries the gap.
-SENSOR_CEILING, TPSC_CEILING, ROLE_CEILING = 1540, 1240, 2330   # with the sensors' C behaviours (their XMIT_DATA builders linked)
+# Issue 15's targets where they are met (fifth session): every role in 2 KiB, the TPSC in 1 KiB. The other
+# sensor roles (with their C behaviours, which link their XMIT_DATA builders) are guarded at today's figure plus
+# a little room (USRC 1292 B is the largest); the TPSC's 1.5x of its baseline (612 B) is not met. `make size`
+# prints each role against its budget; the report carries the gap.
+ROLE_CEILING = 2048     # issue 15 / 6: any role's codec + skeleton in 2 KiB (met: the SPU is 1990 B)
+TPSC_CEILING = 1024     # issue 15: a sensor role in 1 KiB (met by the TPSC only: 1020 B)
+SENSOR_CEILING = 1300   # not the issue's 1024: today's largest sensor role (USRC 1292 B) plus room
 
 
 # roles with a hand-written baseline (firmware/baseline/, BASELINE_ROLES in firmware/Makefile): RLC is a first-level node
