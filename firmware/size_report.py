@@ -74,7 +74,7 @@ def category(obj: str, role: str) -> str:
     if "/gen/" in obj:
         return "skeleton" if name == f"node_{role}.o" else "codec"
     if "/baseline/" in obj:      # the hand-written protocol code stands in for codec + skeleton
-        return "codec" if name == "tpsc_proto.o" else "firmware"
+        return "codec" if name.endswith("_proto.o") or name == "bl_frame.o" else "firmware"
     if "/fw/" in obj:
         return "firmware"
     return "runtime"
@@ -204,7 +204,7 @@ def analyse_stack(build: Path, image: Image, elf: Path) -> None:
     resolve = {f: f"{role}_payload_check" for f in ("arachnae_parser_feed", "verdict")}
     behaviour = {f for f in calls if f.startswith(f"{role}_on_") or f in (f"{role}_send",)}
     notes: list[str] = []
-    if image.role == "baseline_tpsc":
+    if is_baseline(image.role):
         image.stack["parse"] = worst("fw_rx_byte", calls, indirect, frame, {}, push, set(), notes)
         image.stack["dispatch"] = worst("fw_dispatch", calls, indirect, frame, {}, push, {"hal_send"}, notes)
     else:
@@ -220,11 +220,15 @@ def analyse_stack(build: Path, image: Image, elf: Path) -> None:
     image.notes.extend(sorted(set(notes)))
 
 
-def load_images(build: Path) -> list[Image]:
+def is_baseline(role: str) -> bool:
+    return role.startswith("baseline_")
+
+
+def load_images(build: Path, baselines: list[str]) -> list[Image]:
     roles = (build / "roles.mk").read_text().split("\n", 1)[0].split(":=", 1)[1].split()
     images = []
     for target in ("avr", "m0"):
-        for role in roles + ["baseline_tpsc"]:
+        for role in roles + [f"baseline_{b}" for b in baselines]:
             elf, mp = build / target / f"{role}.elf", build / target / f"{role}.map"
             if not elf.exists() or not mp.exists():
                 raise SystemExit(f"size_report: {elf} missing; run `make -C firmware images` first")
@@ -237,7 +241,8 @@ def load_images(build: Path) -> list[Image]:
 
 def table(images: list[Image], target: str) -> list[str]:
     head = (f"{'role':14} {'codec t/d/b':>14} {'skeleton t/d/b':>15} {'codec+skel':>10} "
-            f"{'firmware t/b':>13} {'image flash':>11} {'image RAM':>9} {'stack parse/dispatch/node':>26}")
+            f"{'firmware t/b':>13} {'image flash':>11} {'static RAM':>10} {'stack parse/dispatch/node':>26} "
+            f"{'RAM+stack':>9}")
     rows = [head, "-" * len(head)]
     for img in images:
         if img.target != target:
@@ -245,8 +250,8 @@ def table(images: list[Image], target: str) -> list[str]:
         c, s, f, t = img.parts["codec"], img.parts["skeleton"], img.parts["firmware"], img.total
         stack = f"{img.stack.get('parse', 0)}/{img.stack.get('dispatch', 0)}/{img.stack.get('node', 0)}"
         rows.append(f"{img.role:14} {f'{c.text}/{c.data}/{c.bss}':>14} {f'{s.text}/{s.data}/{s.bss}':>15} "
-                    f"{c.flash + s.flash:>10} {f'{f.text}/{f.bss}':>13} {t.flash:>11} {t.data + t.bss:>9} "
-                    f"{stack:>26}")
+                    f"{c.flash + s.flash:>10} {f'{f.text}/{f.bss}':>13} {t.flash:>11} {t.data + t.bss:>10} "
+                    f"{stack:>26} {t.data + t.bss + img.stack.get('node', 0):>9}")
     return rows
 
 
@@ -272,9 +277,9 @@ def budgets(images: list[Image], failures: list[str]) -> list[str]:
            f"any role <= {AVR_FLASH_BUDGET}; the codec has no data or bss"]
     for img in images:
         c = img.parts["codec"]
-        if (c.data or c.bss) and img.role != "baseline_tpsc":
+        if (c.data or c.bss) and not is_baseline(img.role):
             failures.append(f"{img.target} {img.role}: the codec has {c.data} bytes of data and {c.bss} of bss")
-        if img.target == "avr" and img.role != "baseline_tpsc":
+        if img.target == "avr" and not is_baseline(img.role):
             used = codec_skel(img)
             limit = SENSOR_FLASH_BUDGET if img.role in SENSOR_ROLES else AVR_FLASH_BUDGET
             verdict = "fits" if used <= limit else f"OVER by {used - limit}"
@@ -284,8 +289,8 @@ def budgets(images: list[Image], failures: list[str]) -> list[str]:
 
 def comparison(images: list[Image], nanopb: list[Image]) -> list[str]:
     """Ours beside the hand-written baseline and nanopb, per role (AVR)."""
-    base = next(i for i in images if i.target == "avr" and i.role == "baseline_tpsc")
-    baselines = {"tpsc": codec_skel(base)}
+    base_images = {i.role.removeprefix("baseline_"): i for i in images if i.target == "avr" and is_baseline(i.role)}
+    baselines = {role: codec_skel(i) for role, i in base_images.items()}
     npb = {i.role: i.parts["codec"].flash for i in nanopb}
     head = (f"{'role':8} {'ours codec+skel':>15} {'ours msg_*.c':>12} {'baseline':>9} {'ours/baseline':>13} "
             f"{'nanopb codec':>12} {'nanopb/ours':>11}")
@@ -293,7 +298,7 @@ def comparison(images: list[Image], nanopb: list[Image]) -> list[str]:
            "(firmware/nanopb/, runtime + descriptors; no framing, CRC, parser, dispatch or range checks)",
            head, "-" * len(head)]
     for img in images:
-        if img.target != "avr" or img.role == "baseline_tpsc":
+        if img.target != "avr" or is_baseline(img.role):
             continue
         ours = codec_skel(img)
         b, n = baselines.get(img.role), npb.get(img.role)
@@ -301,10 +306,13 @@ def comparison(images: list[Image], nanopb: list[Image]) -> list[str]:
         nratio = f"{n / ours:.2f}x" if n else "-"
         out.append(f"{img.role:8} {ours:>15} {img.messages.flash:>12} {b if b else '-':>9} {ratio:>13} "
                    f"{n if n else '-':>12} {nratio:>11}")
-    gen = next(i for i in images if i.target == "avr" and i.role == "tpsc")
-    out += [f"  TPSC bar: ours <= {TPSC_BASELINE_RATIO} x baseline = {int(TPSC_BASELINE_RATIO * baselines['tpsc'])} bytes; "
-            f"images: generated {gen.total.flash} bytes flash, {gen.total.data + gen.total.bss} RAM; "
-            f"baseline {base.total.flash} bytes flash, {base.total.data + base.total.bss} RAM"]
+    if "tpsc" in baselines:
+        out.append(f"  TPSC bar: ours <= {TPSC_BASELINE_RATIO} x baseline = {int(TPSC_BASELINE_RATIO * baselines['tpsc'])} bytes")
+    for role, base in base_images.items():
+        gen = next(i for i in images if i.target == "avr" and i.role == role)
+        out.append(f"  {role} images: generated {gen.total.flash} bytes flash, {gen.total.data + gen.total.bss} static RAM; "
+                   f"baseline {base.total.flash} bytes flash, {base.total.data + base.total.bss} static RAM"
+                   + ("" if role == "tpsc" else " (baseline: protocol code, hook stubs for the behaviour)"))
     return out
 
 
@@ -312,15 +320,18 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--build", default=str(HERE / "build"), help="firmware build folder")
     ap.add_argument("--nanopb", default="", help="roles with a nanopb build to compare with (space separated)")
+    ap.add_argument("--baselines", default="tpsc", help="roles with a hand-written baseline image (space separated)")
     args = ap.parse_args(argv)
     build = Path(args.build)
-    images = load_images(build)
+    images = load_images(build, args.baselines.split())
     nanopb = load_nanopb(build, args.nanopb.split())
     failures: list[str] = []
     out: list[str] = []
     for target, name in (("avr", "AVR ATmega328P, avr-gcc -Os"), ("m0", "Cortex-M0, arm-none-eabi-gcc -Os")):
-        out += ["", f"== {name}: bytes (t/d/b = text/data/bss; stack in bytes, worst case of the static call graph:"
-                f" parse = RX interrupt path, dispatch = skeleton without the behaviour, node = main + deepest ISR)"]
+        out += ["", f"== {name}: bytes (t/d/b = text/data/bss; static RAM = data + bss of the image; stack in bytes,"
+                f" worst case of the static call graph: parse = RX interrupt path, dispatch = skeleton without the"
+                f" behaviour, node = main + deepest ISR; RAM+stack = static RAM + node stack, the RAM the role needs"
+                f" at most{', of 2048 on an ATmega328P' if target == 'avr' else ''})"]
         out += table(images, target)
     out += budgets(images, failures)
     out += comparison(images, nanopb)

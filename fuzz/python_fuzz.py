@@ -40,7 +40,9 @@ def build_c_codec(out_dir: Path) -> ctypes.CDLL:
     subprocess.run(["gcc", "-std=c99", "-O1", "-shared", "-fPIC", "-Wall", "-Wextra", "-Werror",
                     f"-I{GEN_C}", *srcs, "-o", str(so)], check=True)
     lib = ctypes.CDLL(str(so))
-    lib.arachnae_frame_decode.restype = ctypes.c_int
+    # arachnae_status is one byte (uint8_t, issue 15): c_int would read the register's undefined upper bytes
+    status = ctypes.c_uint8
+    lib.arachnae_frame_decode.restype = status
     lib.arachnae_frame_decode.argtypes = [ctypes.c_char_p, ctypes.c_uint16, ctypes.c_uint16,
                                           ctypes.c_void_p, ctypes.c_void_p]
     # the reflection layer (arachnae_generic.h): fields by index, tagged-union encode/decode
@@ -53,7 +55,7 @@ def build_c_codec(out_dir: Path) -> ctypes.CDLL:
     }
     for name, argtypes in signatures.items():
         fn = getattr(lib, name)
-        fn.restype, fn.argtypes = ctypes.c_int, argtypes
+        fn.restype, fn.argtypes = status, argtypes
     return lib
 
 

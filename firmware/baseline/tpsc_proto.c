@@ -1,29 +1,15 @@
 /*
  * TPSC protocol code as a firmware engineer writes it by hand: one receive buffer
  * of the largest frame the TPSC takes (6 bytes, it receives only empty payloads),
- * a switch over opcodes, memcpy of the fields, a bitwise CRC-16/IBM-3740.
+ * a switch over opcodes, memcpy of the fields, a bitwise CRC-16/IBM-3740 (bl_frame.c, with the send).
  * Same wire behaviour as the generated skeleton for the frames a TPSC accepts;
  * it checks less (no per-message LENGTH/RANGE table, one fixed buffer).
  */
-#include <string.h>
-
 #include "hal.h"
 #include "tpsc_proto.h"
 
 uint8_t bl_frame[6];
 static uint8_t rx_n, rx_skip;
-
-static uint16_t crc16(const uint8_t *p, uint8_t n)
-{
-    uint16_t crc = 0xFFFFu;
-    uint8_t i;
-    while (n--) {
-        crc = (uint16_t)(crc ^ (uint16_t)((uint16_t)*p++ << 8));
-        for (i = 0; i < 8u; i++)
-            crc = (crc & 0x8000u) ? (uint16_t)((uint16_t)(crc << 1) ^ 0x1021u) : (uint16_t)(crc << 1);
-    }
-    return crc;
-}
 
 uint8_t bl_rx(uint8_t byte)
 {
@@ -40,7 +26,7 @@ uint8_t bl_rx(uint8_t byte)
     }
     if (rx_n < sizeof bl_frame)
         return 0;
-    if (crc16(bl_frame, 4) != (uint16_t)(((uint16_t)bl_frame[4] << 8) | bl_frame[5]))
+    if (bl_crc16(bl_frame, 4) != (uint16_t)(((uint16_t)bl_frame[4] << 8) | bl_frame[5]))
         return 0;
     return (uint8_t)(bl_frame[0] == BL_OWN || bl_frame[0] == BL_BROADCAST);
 }
@@ -49,21 +35,6 @@ void bl_gap(void)
 {
     rx_n = 0;
     rx_skip = 0;
-}
-
-void bl_send(uint8_t dst, uint8_t opcode, const uint8_t *payload, uint8_t n)
-{
-    uint8_t f[7];
-    uint16_t crc;
-    f[0] = dst;
-    f[1] = BL_OWN;
-    f[2] = opcode;
-    f[3] = n;
-    memcpy(&f[4], payload, n);
-    crc = crc16(f, (uint8_t)(4u + n));
-    f[4 + n] = (uint8_t)(crc >> 8);
-    f[5 + n] = (uint8_t)crc;
-    hal_send(f, (uint16_t)(6u + n));
 }
 
 void bl_dispatch(const uint8_t *f)

@@ -1,6 +1,7 @@
 /*
  * hal.h for a Cortex-M0 size image: an nRF51-style UART (base 0x40002000) and the
- * SysTick at 1 kHz; the idle gap is timed in whole milliseconds from the tick.
+ * SysTick at 1 kHz; the idle gap is timed in whole milliseconds from the tick. GPIO pins: 2 DE and /RE,
+ * 3 collision-detect latch, 4 carrier detect, 5 test point, 0..1 the sensor inputs.
  * Built and measured (make size), not run: no M0 simulator is part of the SIL.
  */
 #include "role_config.h"
@@ -20,6 +21,9 @@
 #define GPIO_OUTSET REG(0x50000508UL)
 #define GPIO_OUTCLR REG(0x5000050CUL)
 #define GPIO_IN REG(0x50000510UL)
+#define GPIO_DIRSET REG(0x50000518UL)
+#define GPIO_PIN_CNF(n) REG(0x50000700UL + 4UL * (n))   /* 0: input, buffer connected, no pull */
+#define PIN_CNF_PULLUP (3UL << 2)
 #define SYST_CSR REG(0xE000E010UL)
 #define SYST_RVR REG(0xE000E014UL)
 #define NVIC_ISER REG(0xE000E100UL)
@@ -27,6 +31,9 @@
 #define PIN_DE (1UL << 2)
 #define PIN_TP (1UL << 5)
 #define PIN_CD (1UL << 3)   /* collision-detect latch */
+/* Carrier detect, the same board assumption as the AVR's PC3 (avr/hal_avr.c): the transceiver's RO through a
+ * retriggerable monostable of one character, high from a frame's start bit on, before its first byte is in. */
+#define PIN_CARRIER (1UL << 4)
 #define GAP_MS ((FW_IDLE_GAP_US + 999UL) / 1000UL)
 
 static volatile uint16_t ms, last_rx_ms;
@@ -42,6 +49,11 @@ void hal_init(void)
     UART_INTENSET = 1UL << 2;                                    /* RXDRDY */
     UART_STARTRX = 1u;
     UART_STARTTX = 1u;
+    GPIO_DIRSET = PIN_DE | PIN_TP;
+    GPIO_PIN_CNF(0) = PIN_CNF_PULLUP;                            /* the sensor inputs, active low */
+    GPIO_PIN_CNF(1) = PIN_CNF_PULLUP;
+    GPIO_PIN_CNF(3) = 0;                                         /* the latch and carrier detect: inputs */
+    GPIO_PIN_CNF(4) = 0;
     SYST_RVR = CPU_HZ / 1000UL - 1UL;
     SYST_CSR = 7u;
 }
@@ -109,7 +121,7 @@ uint8_t hal_inputs(void) { return (uint8_t)(~GPIO_IN & 0x03u); }
 uint16_t hal_line_quiet_ms(void)
 {
     uint16_t rx = (uint16_t)(ms - last_rx_ms), tx = (uint16_t)(ms - tx_end_ms);
-    if (gap_armed)
+    if (gap_armed || (GPIO_IN & PIN_CARRIER))       /* a frame is coming in, or just began */
         return 0;
     return sent && tx < rx ? tx : rx;
 }

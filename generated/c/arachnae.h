@@ -28,7 +28,7 @@
 #endif
 
 /* Error kinds, same order as the Python codec; a whole frame is checked in this order. */
-typedef enum {
+enum {
     ARACHNAE_OK = 0, /* success */
     ARACHNAE_TRUNCATED = 1, /* fewer bytes than header+crc, or than header+length+crc */
     ARACHNAE_OVERSIZE = 2, /* more bytes than the length byte says, or than the parser's buffer holds */
@@ -39,7 +39,10 @@ typedef enum {
     ARACHNAE_RANGE = 7, /* a field outside its raw range, enum or flags mask, or not a node address */
     ARACHNAE_BUFFER = 8, /* caller's output buffer too small */
     ARACHNAE_NONE = 9 /* parser only: nothing to report yet (not an error) */
-} arachnae_status;
+};
+/* One byte, not the enum type: an enum is an int, two registers on an 8-bit core (issue 15: -56 bytes
+ * of AVR flash for the TPSC). Holds one of the constants above. */
+typedef uint8_t arachnae_status;
 
 /* ---- frame layout (spec frame, seed 3.2.2 / decision 1) ---- */
 #define ARACHNAE_FRAME_DST 0
@@ -516,6 +519,7 @@ const uint8_t *arachnae_parser_frame(const arachnae_parser *p, uint16_t *len);
  *   arachnae_x_validate(payload, len)        LENGTH, then RANGE, on the wire bytes
  *   arachnae_x_decode(payload, len, &out)    validate, then fill out
  *   arachnae_x_check(&m)                     RANGE on a struct
+ *   arachnae_x_pack(&m, payload)             the bytes of a checked struct, no checks
  *   arachnae_x_encode(&m, payload, cap, &len)  check, then BUFFER, then the bytes
  *   arachnae_x_build(&m, dst, src, frame, cap, &frame_len)  a whole frame
  * Messages without fields have only validate and build. */
@@ -538,6 +542,9 @@ arachnae_status arachnae_id_ack_decode(const uint8_t *payload, uint8_t len, arac
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_id_ack_unpack(const uint8_t *payload, uint8_t len, arachnae_id_ack_t *out);
 arachnae_status arachnae_id_ack_check(const arachnae_id_ack_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_id_ack_pack(const arachnae_id_ack_t *m, uint8_t *payload);
 arachnae_status arachnae_id_ack_encode(const arachnae_id_ack_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_id_ack_build(const arachnae_id_ack_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -556,6 +563,9 @@ arachnae_status arachnae_status_ack_busy_decode(const uint8_t *payload, uint8_t 
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_status_ack_busy_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_busy_t *out);
 arachnae_status arachnae_status_ack_busy_check(const arachnae_status_ack_busy_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_status_ack_busy_pack(const arachnae_status_ack_busy_t *m, uint8_t *payload);
 arachnae_status arachnae_status_ack_busy_encode(const arachnae_status_ack_busy_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_status_ack_busy_build(const arachnae_status_ack_busy_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -570,6 +580,9 @@ arachnae_status arachnae_status_ack_order_decode(const uint8_t *payload, uint8_t
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_status_ack_order_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_order_t *out);
 arachnae_status arachnae_status_ack_order_check(const arachnae_status_ack_order_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_status_ack_order_pack(const arachnae_status_ack_order_t *m, uint8_t *payload);
 arachnae_status arachnae_status_ack_order_encode(const arachnae_status_ack_order_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_status_ack_order_build(const arachnae_status_ack_order_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -584,6 +597,9 @@ arachnae_status arachnae_status_ack_range_decode(const uint8_t *payload, uint8_t
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_status_ack_range_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_range_t *out);
 arachnae_status arachnae_status_ack_range_check(const arachnae_status_ack_range_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_status_ack_range_pack(const arachnae_status_ack_range_t *m, uint8_t *payload);
 arachnae_status arachnae_status_ack_range_encode(const arachnae_status_ack_range_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_status_ack_range_build(const arachnae_status_ack_range_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -601,6 +617,9 @@ arachnae_status arachnae_status_ack_mmc_decode(const uint8_t *payload, uint8_t l
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_status_ack_mmc_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_mmc_t *out);
 arachnae_status arachnae_status_ack_mmc_check(const arachnae_status_ack_mmc_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_status_ack_mmc_pack(const arachnae_status_ack_mmc_t *m, uint8_t *payload);
 arachnae_status arachnae_status_ack_mmc_encode(const arachnae_status_ack_mmc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_status_ack_mmc_build(const arachnae_status_ack_mmc_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -620,6 +639,9 @@ arachnae_status arachnae_post_report_decode(const uint8_t *payload, uint8_t len,
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_post_report_unpack(const uint8_t *payload, uint8_t len, arachnae_post_report_t *out);
 arachnae_status arachnae_post_report_check(const arachnae_post_report_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_post_report_pack(const arachnae_post_report_t *m, uint8_t *payload);
 arachnae_status arachnae_post_report_encode(const arachnae_post_report_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_post_report_build(const arachnae_post_report_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -650,6 +672,9 @@ arachnae_status arachnae_xmit_record_decode(const uint8_t *payload, uint8_t len,
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_xmit_record_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_record_t *out);
 arachnae_status arachnae_xmit_record_check(const arachnae_xmit_record_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_xmit_record_pack(const arachnae_xmit_record_t *m, uint8_t *payload);
 arachnae_status arachnae_xmit_record_encode(const arachnae_xmit_record_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_record_build(const arachnae_xmit_record_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -667,6 +692,9 @@ arachnae_status arachnae_data_decode(const uint8_t *payload, uint8_t len, arachn
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_data_unpack(const uint8_t *payload, uint8_t len, arachnae_data_t *out);
 arachnae_status arachnae_data_check(const arachnae_data_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_data_pack(const arachnae_data_t *m, uint8_t *payload);
 arachnae_status arachnae_data_encode(const arachnae_data_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_data_build(const arachnae_data_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -682,6 +710,9 @@ arachnae_status arachnae_move_decode(const uint8_t *payload, uint8_t len, arachn
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_move_unpack(const uint8_t *payload, uint8_t len, arachnae_move_t *out);
 arachnae_status arachnae_move_check(const arachnae_move_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_move_pack(const arachnae_move_t *m, uint8_t *payload);
 arachnae_status arachnae_move_encode(const arachnae_move_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_move_build(const arachnae_move_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -698,6 +729,9 @@ arachnae_status arachnae_move_relayed_decode(const uint8_t *payload, uint8_t len
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_move_relayed_unpack(const uint8_t *payload, uint8_t len, arachnae_move_relayed_t *out);
 arachnae_status arachnae_move_relayed_check(const arachnae_move_relayed_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_move_relayed_pack(const arachnae_move_relayed_t *m, uint8_t *payload);
 arachnae_status arachnae_move_relayed_encode(const arachnae_move_relayed_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_move_relayed_build(const arachnae_move_relayed_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -716,6 +750,9 @@ arachnae_status arachnae_setup_decode(const uint8_t *payload, uint8_t len, arach
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_setup_unpack(const uint8_t *payload, uint8_t len, arachnae_setup_t *out);
 arachnae_status arachnae_setup_check(const arachnae_setup_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_setup_pack(const arachnae_setup_t *m, uint8_t *payload);
 arachnae_status arachnae_setup_encode(const arachnae_setup_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_setup_build(const arachnae_setup_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -732,6 +769,9 @@ arachnae_status arachnae_speak_decode(const uint8_t *payload, uint8_t len, arach
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_speak_unpack(const uint8_t *payload, uint8_t len, arachnae_speak_t *out);
 arachnae_status arachnae_speak_check(const arachnae_speak_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_speak_pack(const arachnae_speak_t *m, uint8_t *payload);
 arachnae_status arachnae_speak_encode(const arachnae_speak_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_speak_build(const arachnae_speak_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -748,6 +788,9 @@ arachnae_status arachnae_speak_resident_decode(const uint8_t *payload, uint8_t l
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_speak_resident_unpack(const uint8_t *payload, uint8_t len, arachnae_speak_resident_t *out);
 arachnae_status arachnae_speak_resident_check(const arachnae_speak_resident_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_speak_resident_pack(const arachnae_speak_resident_t *m, uint8_t *payload);
 arachnae_status arachnae_speak_resident_encode(const arachnae_speak_resident_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_speak_resident_build(const arachnae_speak_resident_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -764,6 +807,9 @@ arachnae_status arachnae_lcd_text_decode(const uint8_t *payload, uint8_t len, ar
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_lcd_text_unpack(const uint8_t *payload, uint8_t len, arachnae_lcd_text_t *out);
 arachnae_status arachnae_lcd_text_check(const arachnae_lcd_text_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_lcd_text_pack(const arachnae_lcd_text_t *m, uint8_t *payload);
 arachnae_status arachnae_lcd_text_encode(const arachnae_lcd_text_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_lcd_text_build(const arachnae_lcd_text_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -778,6 +824,9 @@ arachnae_status arachnae_uic_alert_decode(const uint8_t *payload, uint8_t len, a
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_uic_alert_unpack(const uint8_t *payload, uint8_t len, arachnae_uic_alert_t *out);
 arachnae_status arachnae_uic_alert_check(const arachnae_uic_alert_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_uic_alert_pack(const arachnae_uic_alert_t *m, uint8_t *payload);
 arachnae_status arachnae_uic_alert_encode(const arachnae_uic_alert_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_uic_alert_build(const arachnae_uic_alert_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -792,6 +841,9 @@ arachnae_status arachnae_head_set_abs_decode(const uint8_t *payload, uint8_t len
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_head_set_abs_unpack(const uint8_t *payload, uint8_t len, arachnae_head_set_abs_t *out);
 arachnae_status arachnae_head_set_abs_check(const arachnae_head_set_abs_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_head_set_abs_pack(const arachnae_head_set_abs_t *m, uint8_t *payload);
 arachnae_status arachnae_head_set_abs_encode(const arachnae_head_set_abs_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_head_set_abs_build(const arachnae_head_set_abs_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -806,6 +858,9 @@ arachnae_status arachnae_head_set_rel_decode(const uint8_t *payload, uint8_t len
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_head_set_rel_unpack(const uint8_t *payload, uint8_t len, arachnae_head_set_rel_t *out);
 arachnae_status arachnae_head_set_rel_check(const arachnae_head_set_rel_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_head_set_rel_pack(const arachnae_head_set_rel_t *m, uint8_t *payload);
 arachnae_status arachnae_head_set_rel_encode(const arachnae_head_set_rel_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_head_set_rel_build(const arachnae_head_set_rel_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -853,6 +908,9 @@ arachnae_status arachnae_xmit_data_usrc_decode(const uint8_t *payload, uint8_t l
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_xmit_data_usrc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_usrc_t *out);
 arachnae_status arachnae_xmit_data_usrc_check(const arachnae_xmit_data_usrc_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_xmit_data_usrc_pack(const arachnae_xmit_data_usrc_t *m, uint8_t *payload);
 arachnae_status arachnae_xmit_data_usrc_encode(const arachnae_xmit_data_usrc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_usrc_build(const arachnae_xmit_data_usrc_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -870,6 +928,9 @@ arachnae_status arachnae_xmit_data_tpsc_decode(const uint8_t *payload, uint8_t l
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_xmit_data_tpsc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_tpsc_t *out);
 arachnae_status arachnae_xmit_data_tpsc_check(const arachnae_xmit_data_tpsc_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_xmit_data_tpsc_pack(const arachnae_xmit_data_tpsc_t *m, uint8_t *payload);
 arachnae_status arachnae_xmit_data_tpsc_encode(const arachnae_xmit_data_tpsc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_tpsc_build(const arachnae_xmit_data_tpsc_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -886,6 +947,9 @@ arachnae_status arachnae_xmit_data_irrc_decode(const uint8_t *payload, uint8_t l
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_xmit_data_irrc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_irrc_t *out);
 arachnae_status arachnae_xmit_data_irrc_check(const arachnae_xmit_data_irrc_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_xmit_data_irrc_pack(const arachnae_xmit_data_irrc_t *m, uint8_t *payload);
 arachnae_status arachnae_xmit_data_irrc_encode(const arachnae_xmit_data_irrc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_irrc_build(const arachnae_xmit_data_irrc_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -910,6 +974,9 @@ arachnae_status arachnae_xmit_data_isc_decode(const uint8_t *payload, uint8_t le
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_xmit_data_isc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_isc_t *out);
 arachnae_status arachnae_xmit_data_isc_check(const arachnae_xmit_data_isc_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_xmit_data_isc_pack(const arachnae_xmit_data_isc_t *m, uint8_t *payload);
 arachnae_status arachnae_xmit_data_isc_encode(const arachnae_xmit_data_isc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_isc_build(const arachnae_xmit_data_isc_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -925,6 +992,9 @@ arachnae_status arachnae_xmit_data_tsc_decode(const uint8_t *payload, uint8_t le
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_xmit_data_tsc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_tsc_t *out);
 arachnae_status arachnae_xmit_data_tsc_check(const arachnae_xmit_data_tsc_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_xmit_data_tsc_pack(const arachnae_xmit_data_tsc_t *m, uint8_t *payload);
 arachnae_status arachnae_xmit_data_tsc_encode(const arachnae_xmit_data_tsc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_tsc_build(const arachnae_xmit_data_tsc_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -939,6 +1009,9 @@ arachnae_status arachnae_xmit_data_lsc_decode(const uint8_t *payload, uint8_t le
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_xmit_data_lsc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_lsc_t *out);
 arachnae_status arachnae_xmit_data_lsc_check(const arachnae_xmit_data_lsc_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_xmit_data_lsc_pack(const arachnae_xmit_data_lsc_t *m, uint8_t *payload);
 arachnae_status arachnae_xmit_data_lsc_encode(const arachnae_xmit_data_lsc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_lsc_build(const arachnae_xmit_data_lsc_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -956,6 +1029,9 @@ arachnae_status arachnae_xmit_data_psc_decode(const uint8_t *payload, uint8_t le
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_xmit_data_psc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_psc_t *out);
 arachnae_status arachnae_xmit_data_psc_check(const arachnae_xmit_data_psc_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_xmit_data_psc_pack(const arachnae_xmit_data_psc_t *m, uint8_t *payload);
 arachnae_status arachnae_xmit_data_psc_encode(const arachnae_xmit_data_psc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_xmit_data_psc_build(const arachnae_xmit_data_psc_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -973,6 +1049,9 @@ arachnae_status arachnae_set_alarm_irrc_decode(const uint8_t *payload, uint8_t l
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_set_alarm_irrc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_irrc_t *out);
 arachnae_status arachnae_set_alarm_irrc_check(const arachnae_set_alarm_irrc_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_set_alarm_irrc_pack(const arachnae_set_alarm_irrc_t *m, uint8_t *payload);
 arachnae_status arachnae_set_alarm_irrc_encode(const arachnae_set_alarm_irrc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_set_alarm_irrc_build(const arachnae_set_alarm_irrc_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -991,6 +1070,9 @@ arachnae_status arachnae_set_alarm_isc_decode(const uint8_t *payload, uint8_t le
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_set_alarm_isc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_isc_t *out);
 arachnae_status arachnae_set_alarm_isc_check(const arachnae_set_alarm_isc_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_set_alarm_isc_pack(const arachnae_set_alarm_isc_t *m, uint8_t *payload);
 arachnae_status arachnae_set_alarm_isc_encode(const arachnae_set_alarm_isc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_set_alarm_isc_build(const arachnae_set_alarm_isc_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -1006,6 +1088,9 @@ arachnae_status arachnae_set_alarm_tsc_decode(const uint8_t *payload, uint8_t le
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_set_alarm_tsc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_tsc_t *out);
 arachnae_status arachnae_set_alarm_tsc_check(const arachnae_set_alarm_tsc_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_set_alarm_tsc_pack(const arachnae_set_alarm_tsc_t *m, uint8_t *payload);
 arachnae_status arachnae_set_alarm_tsc_encode(const arachnae_set_alarm_tsc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_set_alarm_tsc_build(const arachnae_set_alarm_tsc_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -1020,6 +1105,9 @@ arachnae_status arachnae_set_alarm_lsc_decode(const uint8_t *payload, uint8_t le
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_set_alarm_lsc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_lsc_t *out);
 arachnae_status arachnae_set_alarm_lsc_check(const arachnae_set_alarm_lsc_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_set_alarm_lsc_pack(const arachnae_set_alarm_lsc_t *m, uint8_t *payload);
 arachnae_status arachnae_set_alarm_lsc_encode(const arachnae_set_alarm_lsc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_set_alarm_lsc_build(const arachnae_set_alarm_lsc_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -1037,6 +1125,9 @@ arachnae_status arachnae_set_alarm_psc_decode(const uint8_t *payload, uint8_t le
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_set_alarm_psc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_psc_t *out);
 arachnae_status arachnae_set_alarm_psc_check(const arachnae_set_alarm_psc_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_set_alarm_psc_pack(const arachnae_set_alarm_psc_t *m, uint8_t *payload);
 arachnae_status arachnae_set_alarm_psc_encode(const arachnae_set_alarm_psc_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_set_alarm_psc_build(const arachnae_set_alarm_psc_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -1058,6 +1149,9 @@ arachnae_status arachnae_leg_target_decode(const uint8_t *payload, uint8_t len, 
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_leg_target_unpack(const uint8_t *payload, uint8_t len, arachnae_leg_target_t *out);
 arachnae_status arachnae_leg_target_check(const arachnae_leg_target_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_leg_target_pack(const arachnae_leg_target_t *m, uint8_t *payload);
 arachnae_status arachnae_leg_target_encode(const arachnae_leg_target_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_leg_target_build(const arachnae_leg_target_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -1089,6 +1183,9 @@ arachnae_status arachnae_leg_report_decode(const uint8_t *payload, uint8_t len, 
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_leg_report_unpack(const uint8_t *payload, uint8_t len, arachnae_leg_report_t *out);
 arachnae_status arachnae_leg_report_check(const arachnae_leg_report_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_leg_report_pack(const arachnae_leg_report_t *m, uint8_t *payload);
 arachnae_status arachnae_leg_report_encode(const arachnae_leg_report_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_leg_report_build(const arachnae_leg_report_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -1113,6 +1210,9 @@ arachnae_status arachnae_joint_target_decode(const uint8_t *payload, uint8_t len
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_joint_target_unpack(const uint8_t *payload, uint8_t len, arachnae_joint_target_t *out);
 arachnae_status arachnae_joint_target_check(const arachnae_joint_target_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_joint_target_pack(const arachnae_joint_target_t *m, uint8_t *payload);
 arachnae_status arachnae_joint_target_encode(const arachnae_joint_target_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_joint_target_build(const arachnae_joint_target_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);
@@ -1141,6 +1241,9 @@ arachnae_status arachnae_joint_feedback_decode(const uint8_t *payload, uint8_t l
 /* decode without the checks, for a payload that passed validate (the node skeleton's path) */
 void arachnae_joint_feedback_unpack(const uint8_t *payload, uint8_t len, arachnae_joint_feedback_t *out);
 arachnae_status arachnae_joint_feedback_check(const arachnae_joint_feedback_t *m);
+/* the payload bytes of a struct that passed check, returns their number; the caller checked that
+ * they fit (the node skeleton's reply path) */
+uint8_t arachnae_joint_feedback_pack(const arachnae_joint_feedback_t *m, uint8_t *payload);
 arachnae_status arachnae_joint_feedback_encode(const arachnae_joint_feedback_t *m, uint8_t *payload, uint16_t cap, uint8_t *len);
 arachnae_status arachnae_joint_feedback_build(const arachnae_joint_feedback_t *m, uint8_t dst, uint8_t src,
     uint8_t *frame, uint16_t cap, uint16_t *frame_len);

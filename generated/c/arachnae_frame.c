@@ -49,17 +49,19 @@ uint16_t arachnae_crc16(const uint8_t *data, uint16_t len)
 arachnae_status arachnae_frame_seal(uint8_t opcode, uint8_t dst, uint8_t src, uint8_t *frame, uint8_t payload_len,
                                     uint16_t *frame_len)
 {
+    /* only `end` lives across the CRC call: on an 8-bit core one saved register pair, not five (issue 15) */
     uint16_t n = (uint16_t)(ARACHNAE_FRAME_HEADER_SIZE + payload_len);
+    uint8_t *end = frame + n;
     uint16_t crc;
+    *frame_len = (uint16_t)(n + ARACHNAE_FRAME_CRC_SIZE);
     frame[ARACHNAE_FRAME_DST] = dst;
     frame[ARACHNAE_FRAME_SRC] = src;
     frame[ARACHNAE_FRAME_OPCODE] = opcode;
     frame[ARACHNAE_FRAME_LENGTH] = payload_len;
     crc = arachnae_crc16(frame, n);
     /* the CRC travels big-endian after the payload (spec frame.byte_order) */
-    frame[n] = (uint8_t)(crc >> 8);
-    frame[n + 1u] = (uint8_t)(crc & 0xFFu);
-    *frame_len = (uint16_t)(n + ARACHNAE_FRAME_CRC_SIZE);
+    end[0] = (uint8_t)(crc >> 8);
+    end[1] = (uint8_t)(crc & 0xFFu);
     return ARACHNAE_OK;
 }
 
@@ -74,7 +76,7 @@ arachnae_status arachnae_frame_finish(uint8_t *frame, uint16_t cap, uint8_t dst,
 arachnae_status arachnae_frame_check(const uint8_t *frame, uint16_t len, uint16_t own)
 {
     uint16_t need;
-    uint8_t dst;
+    uint8_t dst, for_us;
     if (len < ARACHNAE_FRAME_OVERHEAD)
         return ARACHNAE_TRUNCATED;
     need = (uint16_t)(ARACHNAE_FRAME_OVERHEAD + frame[ARACHNAE_FRAME_LENGTH]);
@@ -82,20 +84,20 @@ arachnae_status arachnae_frame_check(const uint8_t *frame, uint16_t len, uint16_
         return ARACHNAE_TRUNCATED;
     if (len > need)
         return ARACHNAE_OVERSIZE;
+    /* the address verdict before the CRC call, reported after it: one byte lives across the call */
+    dst = frame[ARACHNAE_FRAME_DST];
+    for_us = (uint8_t)(own == ARACHNAE_ANY_ADDRESS || dst == own || dst == ARACHNAE_ADDR_BROADCAST);
     /* MSB-first CRC without xorout: over a good frame with its big-endian CRC it gives 0 */
     if (arachnae_crc16(frame, len) != 0u)
         return ARACHNAE_CHECKSUM;
-    dst = frame[ARACHNAE_FRAME_DST];
-    if (own != ARACHNAE_ANY_ADDRESS && dst != own && dst != ARACHNAE_ADDR_BROADCAST)
-        return ARACHNAE_ADDRESS;
-    return ARACHNAE_OK;
+    return for_us ? ARACHNAE_OK : ARACHNAE_ADDRESS;
 }
 
-/* parser states */
+/* parser states; READY and HELD, the two with a valid frame, are the highest (one compare) */
 #define PS_RECEIVING 0u
 #define PS_COMPLETE 1u  /* frame ended where its length byte said; verdict given */
-#define PS_READY 2u     /* as COMPLETE, and the frame passed every check */
-#define PS_DISCARD 3u   /* error reported; ignore bytes until the gap */
+#define PS_DISCARD 2u   /* error reported; ignore bytes until the gap */
+#define PS_READY 3u     /* as COMPLETE, and the frame passed every check */
 #define PS_HELD 4u      /* READY frame after its gap: kept until the next byte */
 
 void arachnae_parser_init(arachnae_parser *p, uint8_t *buf, uint16_t cap, uint16_t own,
@@ -163,7 +165,7 @@ arachnae_status arachnae_parser_gap(arachnae_parser *p)
 
 const uint8_t *arachnae_parser_frame(const arachnae_parser *p, uint16_t *len)
 {
-    if (p->state != PS_READY && p->state != PS_HELD)
+    if (p->state < PS_READY)   /* neither READY nor HELD */
         return 0;
     *len = p->count;
     return p->buf;

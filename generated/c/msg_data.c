@@ -63,7 +63,7 @@ arachnae_status arachnae_data_check(const arachnae_data_t *m)
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_data_t *m, uint8_t *payload)
+uint8_t arachnae_data_pack(const arachnae_data_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->address & 0xFFu));
     payload[1] = (uint8_t)(((unsigned)(uint16_t)m->kind & 0xFFu));
@@ -80,7 +80,7 @@ arachnae_status arachnae_data_encode(const arachnae_data_t *m, uint8_t *payload,
         return st;
     if (cap < 5u)
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_data_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -92,5 +92,5 @@ arachnae_status arachnae_data_build(const arachnae_data_t *m, uint8_t dst, uint8
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 5u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_DATA, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_DATA, dst, src, frame, arachnae_data_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

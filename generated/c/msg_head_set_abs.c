@@ -46,7 +46,7 @@ arachnae_status arachnae_head_set_abs_check(const arachnae_head_set_abs_t *m)
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_head_set_abs_t *m, uint8_t *payload)
+uint8_t arachnae_head_set_abs_pack(const arachnae_head_set_abs_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)((((unsigned)(uint16_t)m->angle >> 8) & 0xFFu));
     payload[1] = (uint8_t)(((unsigned)(uint16_t)m->angle & 0xFFu));
@@ -60,7 +60,7 @@ arachnae_status arachnae_head_set_abs_encode(const arachnae_head_set_abs_t *m, u
         return st;
     if (cap < 2u)
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_head_set_abs_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -72,5 +72,5 @@ arachnae_status arachnae_head_set_abs_build(const arachnae_head_set_abs_t *m, ui
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 2u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_HEAD_SET_ABS, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_HEAD_SET_ABS, dst, src, frame, arachnae_head_set_abs_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

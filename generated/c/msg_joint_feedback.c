@@ -78,7 +78,7 @@ arachnae_status arachnae_joint_feedback_check(const arachnae_joint_feedback_t *m
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_joint_feedback_t *m, uint8_t *payload)
+uint8_t arachnae_joint_feedback_pack(const arachnae_joint_feedback_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)((((unsigned)(uint16_t)m->angle >> 8) & 0xFFu));
     payload[1] = (uint8_t)(((unsigned)(uint16_t)m->angle & 0xFFu));
@@ -98,7 +98,7 @@ arachnae_status arachnae_joint_feedback_encode(const arachnae_joint_feedback_t *
         return st;
     if (cap < 8u)
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_joint_feedback_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -110,7 +110,7 @@ arachnae_status arachnae_joint_feedback_build(const arachnae_joint_feedback_t *m
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 8u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_JOINT_FEEDBACK, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_JOINT_FEEDBACK, dst, src, frame, arachnae_joint_feedback_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }
 
 /* angle: phys = raw * 1/10 + 0 deg. Integer milli-units, rounding half away from zero (codegen/encoding.py). */

@@ -54,7 +54,7 @@ arachnae_status arachnae_joint_target_check(const arachnae_joint_target_t *m)
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_joint_target_t *m, uint8_t *payload)
+uint8_t arachnae_joint_target_pack(const arachnae_joint_target_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)((((unsigned)(uint16_t)m->angle >> 8) & 0xFFu));
     payload[1] = (uint8_t)(((unsigned)(uint16_t)m->angle & 0xFFu));
@@ -70,7 +70,7 @@ arachnae_status arachnae_joint_target_encode(const arachnae_joint_target_t *m, u
         return st;
     if (cap < 4u)
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_joint_target_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -82,7 +82,7 @@ arachnae_status arachnae_joint_target_build(const arachnae_joint_target_t *m, ui
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 4u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_JOINT_TARGET, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_JOINT_TARGET, dst, src, frame, arachnae_joint_target_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }
 
 /* angle: phys = raw * 1/10 + 0 deg. Integer milli-units, rounding half away from zero (codegen/encoding.py). */

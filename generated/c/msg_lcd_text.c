@@ -59,7 +59,7 @@ arachnae_status arachnae_lcd_text_check(const arachnae_lcd_text_t *m)
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_lcd_text_t *m, uint8_t *payload)
+uint8_t arachnae_lcd_text_pack(const arachnae_lcd_text_t *m, uint8_t *payload)
 {
     uint8_t i;
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->line & 0xFFu));
@@ -76,7 +76,7 @@ arachnae_status arachnae_lcd_text_encode(const arachnae_lcd_text_t *m, uint8_t *
         return st;
     if (cap < (uint16_t)(2u + m->length))
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_lcd_text_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -88,5 +88,5 @@ arachnae_status arachnae_lcd_text_build(const arachnae_lcd_text_t *m, uint8_t ds
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + (uint16_t)(2u + m->length))
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_LCD_TEXT, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_LCD_TEXT, dst, src, frame, arachnae_lcd_text_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

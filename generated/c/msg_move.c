@@ -54,7 +54,7 @@ arachnae_status arachnae_move_check(const arachnae_move_t *m)
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_move_t *m, uint8_t *payload)
+uint8_t arachnae_move_pack(const arachnae_move_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)((((unsigned)(uint16_t)m->mov_cmd & 0x0Fu) << 4) | ((unsigned)(uint16_t)m->param & 0x0Fu));
     return 1u;
@@ -67,7 +67,7 @@ arachnae_status arachnae_move_encode(const arachnae_move_t *m, uint8_t *payload,
         return st;
     if (cap < 1u)
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_move_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -79,5 +79,5 @@ arachnae_status arachnae_move_build(const arachnae_move_t *m, uint8_t dst, uint8
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 1u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_MOVE, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_MOVE, dst, src, frame, arachnae_move_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

@@ -62,7 +62,7 @@ arachnae_status arachnae_move_relayed_check(const arachnae_move_relayed_t *m)
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_move_relayed_t *m, uint8_t *payload)
+uint8_t arachnae_move_relayed_pack(const arachnae_move_relayed_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->address & 0xFFu));
     payload[1] = (uint8_t)((((unsigned)(uint16_t)m->mov_cmd & 0x0Fu) << 4) | ((unsigned)(uint16_t)m->param & 0x0Fu));
@@ -76,7 +76,7 @@ arachnae_status arachnae_move_relayed_encode(const arachnae_move_relayed_t *m, u
         return st;
     if (cap < 2u)
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_move_relayed_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -88,5 +88,5 @@ arachnae_status arachnae_move_relayed_build(const arachnae_move_relayed_t *m, ui
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 2u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_MOVE_RELAYED, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_MOVE_RELAYED, dst, src, frame, arachnae_move_relayed_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

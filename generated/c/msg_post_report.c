@@ -59,7 +59,7 @@ arachnae_status arachnae_post_report_check(const arachnae_post_report_t *m)
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_post_report_t *m, uint8_t *payload)
+uint8_t arachnae_post_report_pack(const arachnae_post_report_t *m, uint8_t *payload)
 {
     uint8_t i;
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->missing_count & 0xFFu));
@@ -75,7 +75,7 @@ arachnae_status arachnae_post_report_encode(const arachnae_post_report_t *m, uin
         return st;
     if (cap < (uint16_t)(1u + m->missing_count))
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_post_report_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -87,5 +87,5 @@ arachnae_status arachnae_post_report_build(const arachnae_post_report_t *m, uint
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + (uint16_t)(1u + m->missing_count))
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_POST_REPORT, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_POST_REPORT, dst, src, frame, arachnae_post_report_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

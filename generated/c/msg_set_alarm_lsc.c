@@ -46,7 +46,7 @@ arachnae_status arachnae_set_alarm_lsc_check(const arachnae_set_alarm_lsc_t *m)
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_set_alarm_lsc_t *m, uint8_t *payload)
+uint8_t arachnae_set_alarm_lsc_pack(const arachnae_set_alarm_lsc_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->limit & 0xFFu));
     return 1u;
@@ -59,7 +59,7 @@ arachnae_status arachnae_set_alarm_lsc_encode(const arachnae_set_alarm_lsc_t *m,
         return st;
     if (cap < 1u)
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_set_alarm_lsc_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -71,7 +71,7 @@ arachnae_status arachnae_set_alarm_lsc_build(const arachnae_set_alarm_lsc_t *m, 
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 1u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_SET_ALARM_LSC, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_SET_ALARM_LSC, dst, src, frame, arachnae_set_alarm_lsc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }
 
 /* limit: raw = 64 * log10(phys / 1/10) lx, table 1. Integer milli-units, rounding half away from zero (codegen/encoding.py). */

@@ -56,7 +56,7 @@ arachnae_status arachnae_setup_check(const arachnae_setup_t *m)
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_setup_t *m, uint8_t *payload)
+uint8_t arachnae_setup_pack(const arachnae_setup_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)((((unsigned)(uint16_t)m->rate & 0x0Fu) << 4) | ((unsigned)(uint16_t)m->amplitude & 0x0Fu));
     payload[1] = (uint8_t)(((unsigned)(uint16_t)m->inflection & 0xFFu));
@@ -71,7 +71,7 @@ arachnae_status arachnae_setup_encode(const arachnae_setup_t *m, uint8_t *payloa
         return st;
     if (cap < 3u)
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_setup_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -83,5 +83,5 @@ arachnae_status arachnae_setup_build(const arachnae_setup_t *m, uint8_t dst, uin
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 3u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_SETUP, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_SETUP, dst, src, frame, arachnae_setup_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

@@ -52,7 +52,7 @@ arachnae_status arachnae_speak_check(const arachnae_speak_t *m)
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_speak_t *m, uint8_t *payload)
+uint8_t arachnae_speak_pack(const arachnae_speak_t *m, uint8_t *payload)
 {
     uint8_t i;
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->repeat & 0xFFu));
@@ -69,7 +69,7 @@ arachnae_status arachnae_speak_encode(const arachnae_speak_t *m, uint8_t *payloa
         return st;
     if (cap < (uint16_t)(2u + m->length))
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_speak_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -81,5 +81,5 @@ arachnae_status arachnae_speak_build(const arachnae_speak_t *m, uint8_t dst, uin
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + (uint16_t)(2u + m->length))
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_SPEAK, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_SPEAK, dst, src, frame, arachnae_speak_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

@@ -55,7 +55,7 @@ arachnae_status arachnae_speak_resident_check(const arachnae_speak_resident_t *m
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_speak_resident_t *m, uint8_t *payload)
+uint8_t arachnae_speak_resident_pack(const arachnae_speak_resident_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->repeat & 0xFFu));
     payload[1] = (uint8_t)(((unsigned)(uint16_t)m->length & 0xFFu));
@@ -70,7 +70,7 @@ arachnae_status arachnae_speak_resident_encode(const arachnae_speak_resident_t *
         return st;
     if (cap < 3u)
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_speak_resident_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -82,5 +82,5 @@ arachnae_status arachnae_speak_resident_build(const arachnae_speak_resident_t *m
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 3u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_SPEAK_RESIDENT, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_SPEAK_RESIDENT, dst, src, frame, arachnae_speak_resident_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

@@ -70,7 +70,7 @@ arachnae_status arachnae_status_ack_mmc_check(const arachnae_status_ack_mmc_t *m
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_status_ack_mmc_t *m, uint8_t *payload)
+uint8_t arachnae_status_ack_mmc_pack(const arachnae_status_ack_mmc_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)((((unsigned)(uint16_t)m->gait & 0x0Fu) << 4) | ((unsigned)(uint16_t)m->direction & 0x0Fu));
     payload[1] = (uint8_t)((((unsigned)(uint16_t)m->leg & 0x0Fu) << 4) | ((unsigned)(uint16_t)m->error & 0x0Fu));
@@ -84,7 +84,7 @@ arachnae_status arachnae_status_ack_mmc_encode(const arachnae_status_ack_mmc_t *
         return st;
     if (cap < 2u)
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_status_ack_mmc_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -96,5 +96,5 @@ arachnae_status arachnae_status_ack_mmc_build(const arachnae_status_ack_mmc_t *m
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 2u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_STATUS_ACK_MMC, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_STATUS_ACK_MMC, dst, src, frame, arachnae_status_ack_mmc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

@@ -46,7 +46,7 @@ arachnae_status arachnae_status_ack_order_check(const arachnae_status_ack_order_
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_status_ack_order_t *m, uint8_t *payload)
+uint8_t arachnae_status_ack_order_pack(const arachnae_status_ack_order_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->status & 0xFFu));
     return 1u;
@@ -59,7 +59,7 @@ arachnae_status arachnae_status_ack_order_encode(const arachnae_status_ack_order
         return st;
     if (cap < 1u)
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_status_ack_order_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -71,5 +71,5 @@ arachnae_status arachnae_status_ack_order_build(const arachnae_status_ack_order_
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 1u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_STATUS_ACK_ORDER, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_STATUS_ACK_ORDER, dst, src, frame, arachnae_status_ack_order_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

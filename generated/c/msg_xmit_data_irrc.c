@@ -43,7 +43,7 @@ arachnae_status arachnae_xmit_data_irrc_check(const arachnae_xmit_data_irrc_t *m
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_xmit_data_irrc_t *m, uint8_t *payload)
+uint8_t arachnae_xmit_data_irrc_pack(const arachnae_xmit_data_irrc_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->left & 0xFFu));
     payload[1] = (uint8_t)(((unsigned)(uint16_t)m->center & 0xFFu));
@@ -58,7 +58,7 @@ arachnae_status arachnae_xmit_data_irrc_encode(const arachnae_xmit_data_irrc_t *
         return st;
     if (cap < 3u)
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_xmit_data_irrc_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -70,7 +70,7 @@ arachnae_status arachnae_xmit_data_irrc_build(const arachnae_xmit_data_irrc_t *m
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 3u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_XMIT_DATA_IRRC, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_XMIT_DATA_IRRC, dst, src, frame, arachnae_xmit_data_irrc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }
 
 /* left: phys = raw * 2/51 + 0 cm. Integer milli-units, rounding half away from zero (codegen/encoding.py). */

@@ -54,7 +54,7 @@ arachnae_status arachnae_xmit_data_isc_check(const arachnae_xmit_data_isc_t *m)
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_xmit_data_isc_t *m, uint8_t *payload)
+uint8_t arachnae_xmit_data_isc_pack(const arachnae_xmit_data_isc_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->longitudinal & 0xFFu));
     payload[1] = (uint8_t)(((unsigned)(uint16_t)m->transverse & 0xFFu));
@@ -68,7 +68,7 @@ arachnae_status arachnae_xmit_data_isc_encode(const arachnae_xmit_data_isc_t *m,
         return st;
     if (cap < 2u)
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_xmit_data_isc_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -80,5 +80,5 @@ arachnae_status arachnae_xmit_data_isc_build(const arachnae_xmit_data_isc_t *m, 
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 2u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_XMIT_DATA_ISC, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_XMIT_DATA_ISC, dst, src, frame, arachnae_xmit_data_isc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

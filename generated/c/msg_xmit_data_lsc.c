@@ -41,7 +41,7 @@ arachnae_status arachnae_xmit_data_lsc_check(const arachnae_xmit_data_lsc_t *m)
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_xmit_data_lsc_t *m, uint8_t *payload)
+uint8_t arachnae_xmit_data_lsc_pack(const arachnae_xmit_data_lsc_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->brightness & 0xFFu));
     return 1u;
@@ -54,7 +54,7 @@ arachnae_status arachnae_xmit_data_lsc_encode(const arachnae_xmit_data_lsc_t *m,
         return st;
     if (cap < 1u)
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_xmit_data_lsc_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -66,7 +66,7 @@ arachnae_status arachnae_xmit_data_lsc_build(const arachnae_xmit_data_lsc_t *m, 
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 1u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_XMIT_DATA_LSC, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_XMIT_DATA_LSC, dst, src, frame, arachnae_xmit_data_lsc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }
 
 /* brightness: raw = 64 * log10(phys / 1/10) lx, table 1. Integer milli-units, rounding half away from zero (codegen/encoding.py). */

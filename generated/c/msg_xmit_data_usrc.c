@@ -47,7 +47,7 @@ arachnae_status arachnae_xmit_data_usrc_check(const arachnae_xmit_data_usrc_t *m
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_xmit_data_usrc_t *m, uint8_t *payload)
+uint8_t arachnae_xmit_data_usrc_pack(const arachnae_xmit_data_usrc_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->distance & 0xFFu));
     payload[1] = (uint8_t)((((unsigned)(uint16_t)m->angle >> 8) & 0xFFu));
@@ -62,7 +62,7 @@ arachnae_status arachnae_xmit_data_usrc_encode(const arachnae_xmit_data_usrc_t *
         return st;
     if (cap < 3u)
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_xmit_data_usrc_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -74,7 +74,7 @@ arachnae_status arachnae_xmit_data_usrc_build(const arachnae_xmit_data_usrc_t *m
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 3u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_XMIT_DATA_USRC, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_XMIT_DATA_USRC, dst, src, frame, arachnae_xmit_data_usrc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }
 
 /* distance: phys = raw * 2/51 + 0 m. Integer milli-units, rounding half away from zero (codegen/encoding.py). */

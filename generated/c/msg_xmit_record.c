@@ -71,7 +71,7 @@ arachnae_status arachnae_xmit_record_check(const arachnae_xmit_record_t *m)
 }
 
 /* The payload bytes of a checked struct, returns their number; the caller checked that they fit. */
-static uint8_t pack(const arachnae_xmit_record_t *m, uint8_t *payload)
+uint8_t arachnae_xmit_record_pack(const arachnae_xmit_record_t *m, uint8_t *payload)
 {
     payload[0] = (uint8_t)(((unsigned)(uint16_t)m->target & 0xFFu));
     payload[1] = (uint8_t)(((unsigned)(uint16_t)m->source & 0xFFu));
@@ -89,7 +89,7 @@ arachnae_status arachnae_xmit_record_encode(const arachnae_xmit_record_t *m, uin
         return st;
     if (cap < 6u)
         return ARACHNAE_BUFFER;
-    *len = pack(m, payload);
+    *len = arachnae_xmit_record_pack(m, payload);
     return ARACHNAE_OK;
 }
 
@@ -101,5 +101,5 @@ arachnae_status arachnae_xmit_record_build(const arachnae_xmit_record_t *m, uint
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 6u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_XMIT_RECORD, dst, src, frame, pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    return arachnae_frame_seal(ARACHNAE_OP_XMIT_RECORD, dst, src, frame, arachnae_xmit_record_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
 }

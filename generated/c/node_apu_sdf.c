@@ -32,10 +32,12 @@ arachnae_status apu_sdf_payload_check(uint8_t opcode, const uint8_t *payload, ui
 }
 
 /* A frame for us whose payload passed apu_sdf_payload_check: call its callback, or
- * build and send the reply to a request (one reply buffer and one send for all of them). */
+ * build and send the reply to a request (one reply buffer, one seal and one send for all of them:
+ * each reply is checked and packed, never built through its _build, issue 15). */
 static arachnae_status deliver(apu_sdf_node *node, const arachnae_header *h, const uint8_t *payload)
 {
     arachnae_status st;
+    uint8_t op, n;
     (void)payload;
     switch (h->opcode) {
     case ARACHNAE_OP_INIT:
@@ -47,7 +49,11 @@ static arachnae_status deliver(apu_sdf_node *node, const arachnae_header *h, con
             return ARACHNAE_OK;
         /* seed 3.2.2: ID_ACK carries the node's own address */
         node->msg.reply_id_ack.address = node->address;
-        st = arachnae_id_ack_build(&node->msg.reply_id_ack, h->src, node->address, node->out, sizeof node->out, &node->out_len);
+        st = arachnae_id_ack_check(&node->msg.reply_id_ack);
+        if (st != ARACHNAE_OK)
+            return st;
+        op = ARACHNAE_OP_ID_ACK;
+        n = arachnae_id_ack_pack(&node->msg.reply_id_ack, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
     case ARACHNAE_OP_STATUS_REQ:
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
@@ -55,7 +61,11 @@ static arachnae_status deliver(apu_sdf_node *node, const arachnae_header *h, con
         /* seed 3.2.3: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_BUSY) */
         node->msg.reply_status.status = 0;
         apu_sdf_on_status_req(node, h, &node->msg.reply_status);
-        st = arachnae_status_ack_busy_build(&node->msg.reply_status, h->src, node->address, node->out, sizeof node->out, &node->out_len);
+        st = arachnae_status_ack_busy_check(&node->msg.reply_status);
+        if (st != ARACHNAE_OK)
+            return st;
+        op = ARACHNAE_OP_STATUS_ACK_BUSY;
+        n = arachnae_status_ack_busy_pack(&node->msg.reply_status, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
     case ARACHNAE_OP_XMIT_GRANT:
         apu_sdf_on_xmit_grant(node, h);
@@ -63,9 +73,10 @@ static arachnae_status deliver(apu_sdf_node *node, const arachnae_header *h, con
     default:
         return ARACHNAE_OK;
     }
-    if (st == ARACHNAE_OK)
-        apu_sdf_send(node, node->out, node->out_len);
-    return st;
+    /* node->out holds the largest reply of this role (node_apu_sdf.h), so it fits */
+    (void)arachnae_frame_seal(op, h->src, node->address, node->out, n, &node->out_len);
+    apu_sdf_send(node, node->out, node->out_len);
+    return ARACHNAE_OK;
 }
 
 arachnae_status apu_sdf_dispatch(apu_sdf_node *node, const uint8_t *frame, uint16_t len)

@@ -33,10 +33,12 @@ arachnae_status lsc_payload_check(uint8_t opcode, const uint8_t *payload, uint8_
 }
 
 /* A frame for us whose payload passed lsc_payload_check: call its callback, or
- * build and send the reply to a request (one reply buffer and one send for all of them). */
+ * build and send the reply to a request (one reply buffer, one seal and one send for all of them:
+ * each reply is checked and packed, never built through its _build, issue 15). */
 static arachnae_status deliver(lsc_node *node, const arachnae_header *h, const uint8_t *payload)
 {
     arachnae_status st;
+    uint8_t op, n;
     switch (h->opcode) {
     case ARACHNAE_OP_INIT:
         lsc_on_init(node, h);
@@ -47,7 +49,11 @@ static arachnae_status deliver(lsc_node *node, const arachnae_header *h, const u
             return ARACHNAE_OK;
         /* seed 3.2.2: ID_ACK carries the node's own address */
         node->msg.reply_id_ack.address = node->address;
-        st = arachnae_id_ack_build(&node->msg.reply_id_ack, h->src, node->address, node->out, sizeof node->out, &node->out_len);
+        st = arachnae_id_ack_check(&node->msg.reply_id_ack);
+        if (st != ARACHNAE_OK)
+            return st;
+        op = ARACHNAE_OP_ID_ACK;
+        n = arachnae_id_ack_pack(&node->msg.reply_id_ack, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
     case ARACHNAE_OP_STATUS_REQ:
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
@@ -55,7 +61,11 @@ static arachnae_status deliver(lsc_node *node, const arachnae_header *h, const u
         /* seed 3.2.10: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_ORDER) */
         node->msg.reply_status.status = 0;
         lsc_on_status_req(node, h, &node->msg.reply_status);
-        st = arachnae_status_ack_order_build(&node->msg.reply_status, h->src, node->address, node->out, sizeof node->out, &node->out_len);
+        st = arachnae_status_ack_order_check(&node->msg.reply_status);
+        if (st != ARACHNAE_OK)
+            return st;
+        op = ARACHNAE_OP_STATUS_ACK_ORDER;
+        n = arachnae_status_ack_order_pack(&node->msg.reply_status, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
     case ARACHNAE_OP_XMIT_DATA:
         lsc_on_xmit_data(node, h);
@@ -67,9 +77,10 @@ static arachnae_status deliver(lsc_node *node, const arachnae_header *h, const u
     default:
         return ARACHNAE_OK;
     }
-    if (st == ARACHNAE_OK)
-        lsc_send(node, node->out, node->out_len);
-    return st;
+    /* node->out holds the largest reply of this role (node_lsc.h), so it fits */
+    (void)arachnae_frame_seal(op, h->src, node->address, node->out, n, &node->out_len);
+    lsc_send(node, node->out, node->out_len);
+    return ARACHNAE_OK;
 }
 
 arachnae_status lsc_dispatch(lsc_node *node, const uint8_t *frame, uint16_t len)

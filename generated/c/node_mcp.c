@@ -41,7 +41,8 @@ arachnae_status mcp_payload_check(uint8_t opcode, const uint8_t *payload, uint8_
 }
 
 /* A frame for us whose payload passed mcp_payload_check: call its callback, or
- * build and send the reply to a request (one reply buffer and one send for all of them). */
+ * build and send the reply to a request (one reply buffer, one seal and one send for all of them:
+ * each reply is checked and packed, never built through its _build, issue 15). */
 static arachnae_status deliver(mcp_node *node, const arachnae_header *h, const uint8_t *payload)
 {
     switch (h->opcode) {

@@ -38,10 +38,12 @@ arachnae_status usrc_payload_check(uint8_t opcode, const uint8_t *payload, uint8
 }
 
 /* A frame for us whose payload passed usrc_payload_check: call its callback, or
- * build and send the reply to a request (one reply buffer and one send for all of them). */
+ * build and send the reply to a request (one reply buffer, one seal and one send for all of them:
+ * each reply is checked and packed, never built through its _build, issue 15). */
 static arachnae_status deliver(usrc_node *node, const arachnae_header *h, const uint8_t *payload)
 {
     arachnae_status st;
+    uint8_t op, n;
     switch (h->opcode) {
     case ARACHNAE_OP_INIT:
         usrc_on_init(node, h);
@@ -52,7 +54,11 @@ static arachnae_status deliver(usrc_node *node, const arachnae_header *h, const 
             return ARACHNAE_OK;
         /* seed 3.2.2: ID_ACK carries the node's own address */
         node->msg.reply_id_ack.address = node->address;
-        st = arachnae_id_ack_build(&node->msg.reply_id_ack, h->src, node->address, node->out, sizeof node->out, &node->out_len);
+        st = arachnae_id_ack_check(&node->msg.reply_id_ack);
+        if (st != ARACHNAE_OK)
+            return st;
+        op = ARACHNAE_OP_ID_ACK;
+        n = arachnae_id_ack_pack(&node->msg.reply_id_ack, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
     case ARACHNAE_OP_STATUS_REQ:
         if (h->dst == ARACHNAE_ADDR_BROADCAST)
@@ -60,7 +66,11 @@ static arachnae_status deliver(usrc_node *node, const arachnae_header *h, const 
         /* seed 3.2.11: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_RANGE) */
         node->msg.reply_status.status = 0;
         usrc_on_status_req(node, h, &node->msg.reply_status);
-        st = arachnae_status_ack_range_build(&node->msg.reply_status, h->src, node->address, node->out, sizeof node->out, &node->out_len);
+        st = arachnae_status_ack_range_check(&node->msg.reply_status);
+        if (st != ARACHNAE_OK)
+            return st;
+        op = ARACHNAE_OP_STATUS_ACK_RANGE;
+        n = arachnae_status_ack_range_pack(&node->msg.reply_status, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
     case ARACHNAE_OP_HEAD_SET_ABS:
         arachnae_head_set_abs_unpack(payload, h->length, &node->msg.rx_head_set_abs);
@@ -85,9 +95,10 @@ static arachnae_status deliver(usrc_node *node, const arachnae_header *h, const 
     default:
         return ARACHNAE_OK;
     }
-    if (st == ARACHNAE_OK)
-        usrc_send(node, node->out, node->out_len);
-    return st;
+    /* node->out holds the largest reply of this role (node_usrc.h), so it fits */
+    (void)arachnae_frame_seal(op, h->src, node->address, node->out, n, &node->out_len);
+    usrc_send(node, node->out, node->out_len);
+    return ARACHNAE_OK;
 }
 
 arachnae_status usrc_dispatch(usrc_node *node, const uint8_t *frame, uint16_t len)

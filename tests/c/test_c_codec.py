@@ -365,7 +365,8 @@ def test_linker_drops_what_a_role_does_not_use(spec, tmp_path):
         present = any(n.startswith(f"arachnae_{m.name.lower()}_") for n in names)
         if m.name.lower() not in used:
             assert not present, f"{m.name} code linked into the TPSC image"
-    assert "arachnae_id_ack_build" in names and "tpsc_dispatch" in names
+    # the skeleton answers ID_REQ with a checked and packed ID_ACK (its _build is not needed, issue 15)
+    assert "arachnae_id_ack_pack" in names and "tpsc_dispatch" in names
     assert not any(n.startswith("arachnae_log10_") for n in names)
     assert "arachnae_messages" not in names  # the reflection layer stays out
     # and it works: ID_REQ in, ID_ACK out

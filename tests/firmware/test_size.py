@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 
@@ -10,21 +11,31 @@ import pytest
 from tests.firmware.conftest import FIRMWARE, make
 
 SENSORS = ("usrc", "tpsc", "irrc", "isc", "tsc", "lsc", "psc")
-# What the generated C reaches today, with a little room: a regression past these fails. Issue 15's targets
-# (sensors 1024, TPSC 633 = 1.5x its baseline, any role 2048) are not reached yet; `make size` prints each
-# role against its budget and the issue's note carries the gap.
-SENSOR_CEILING, TPSC_CEILING, ROLE_CEILING = 1540, 1240, 2330   # with the sensors' C behaviours (their XMIT_DATA builders linked)
+# Issue 15's targets where they are met (fifth session): every role in 2 KiB, the TPSC in 1 KiB. The other
+# sensor roles (with their C behaviours, which link their XMIT_DATA builders) are guarded at today's figure plus
+# a little room (USRC 1292 B is the largest); the TPSC's 1.5x of its baseline (612 B) is not met. `make size`
+# prints each role against its budget; the report carries the gap.
+ROLE_CEILING = 2048     # issue 15 / 6: any role's codec + skeleton in 2 KiB (met: the SPU is 1990 B)
+TPSC_CEILING = 1024     # issue 15: a sensor role in 1 KiB (met by the TPSC only: 1020 B)
+SENSOR_CEILING = 1300   # not the issue's 1024: today's largest sensor role (USRC 1292 B) plus room
+
+
+# roles with a hand-written baseline (firmware/baseline/, BASELINE_ROLES in firmware/Makefile): RLC is a first-level node
+BASELINES = ("tpsc", "usrc", "rlc")
 
 
 def report(build, *extra):
-    r = subprocess.run([sys.executable, str(FIRMWARE / "size_report.py"), "--build", str(build), *extra],
-                       capture_output=True, text=True)
+    r = subprocess.run([sys.executable, str(FIRMWARE / "size_report.py"), "--build", str(build),
+                        "--baselines", " ".join(BASELINES), *extra], capture_output=True, text=True)
     return r, [row for row in json.loads((build / "size.json").read_text()) if row["target"] in ("avr", "m0")]
 
 
+def codec_skeleton(row) -> int:
+    return sum(row[p][k] for p in ("codec", "skeleton") for k in ("text", "data"))
+
+
 def avr_codec_skeleton(rows) -> dict[str, int]:
-    return {r["role"]: sum(r[p][k] for p in ("codec", "skeleton") for k in ("text", "data"))
-            for r in rows if r["target"] == "avr" and r["role"] != "baseline_tpsc"}
+    return {r["role"]: codec_skeleton(r) for r in rows if r["target"] == "avr" and not r["role"].startswith("baseline_")}
 
 
 def test_size_report_runs_and_the_codec_has_no_data_or_bss(firmware_built, spec):
@@ -32,9 +43,10 @@ def test_size_report_runs_and_the_codec_has_no_data_or_bss(firmware_built, spec)
     assert r.returncode == 0, r.stderr
     assert "== AVR ATmega328P" in r.stdout and "== Cortex-M0" in r.stdout
     roles = {row["role"] for row in rows}
-    assert {x.lower() for x in spec.roles} <= roles and "baseline_tpsc" in roles
+    assert {x.lower() for x in spec.roles} <= roles and {f"baseline_{b}" for b in BASELINES} <= roles
+    assert "static RAM" in r.stdout and "RAM+stack" in r.stdout
     for row in rows:
-        if row["role"] != "baseline_tpsc":
+        if not row["role"].startswith("baseline_"):
             assert row["codec"]["data"] == 0 and row["codec"]["bss"] == 0, row
             assert row["codec"]["text"] > 0 and row["skeleton"]["text"] > 0, row
 
@@ -61,9 +73,30 @@ def test_make_size_prints_nanopb_beside_ours_and_the_baseline(firmware_built):
     # role, ours, ours msg_*.c, baseline, ours/baseline, nanopb, nanopb/ours
     base = next(row for row in rows if row["role"] == "baseline_tpsc" and row["target"] == "avr")
     assert int(cols[1]) == ours["tpsc"]
-    assert int(cols[3]) == sum(base[p][k] for p in ("codec", "skeleton") for k in ("text", "data")) > 0
+    assert int(cols[3]) == codec_skeleton(base) > 0
     assert int(cols[5]) == nanopb["tpsc"]["text"] + nanopb["tpsc"]["data"] > 0
     assert cols[4] == f"{ours['tpsc'] / int(cols[3]):.2f}x"
+    # every role with a baseline gets its ratio (issue 15: USRC and a first-level role beside the TPSC)
+    for role in BASELINES:
+        base = next(row for row in rows if row["role"] == f"baseline_{role}" and row["target"] == "avr")
+        cols = next(l for l in lines[start:] if l.startswith(f"{role} ")).split()
+        assert int(cols[3]) == codec_skeleton(base) > 0 and cols[4] == f"{ours[role] / codec_skeleton(base):.2f}x"
+
+
+def test_the_baselines_speak_the_spec(spec):
+    """The hand-written baselines type their numbers in (that is what they measure): they must be the spec's."""
+    ops = {m.name: m.opcode for m in spec.messages}
+    for role in BASELINES:
+        text = (FIRMWARE / "baseline" / role / "bl_role.h").read_text()
+        defs = {k: int(v, 16 if v.startswith("0x") else 10)
+                for k, v in re.findall(r"#define BL_(\w+) (0x[0-9A-Fa-f]+|\d+)u", text)}
+        assert defs.pop("OWN") == spec.role_nodes(role.upper())[0].address
+        rx = [m for m in spec.messages if m.name in {x.name for x in spec.receives(role.upper())}]
+        assert defs.pop("RX_MAX") == spec.frame.overhead + max(m.max_size for m in rx)
+        defs.pop("TX_MAX")
+        if "SPU" in defs:       # the TPSC's master
+            assert defs.pop("SPU") == spec.role_nodes("SPU")[0].address
+        assert defs and all(ops[k.removeprefix("OP_")] == v for k, v in defs.items()), defs
 
 
 def test_stack_figures_cover_the_decode_paths(firmware_built):
@@ -74,3 +107,8 @@ def test_stack_figures_cover_the_decode_paths(firmware_built):
         assert not [n for n in row["notes"] if n.startswith(("unresolved", "recursion"))], row
     tpsc = next(r for r in rows if r["role"] == "tpsc" and r["target"] == "avr")
     assert tpsc["stack"]["node"] < 2048 // 4, "a TPSC should need well under a quarter of the 328P's RAM"
+    # static RAM (data + bss) plus the whole node's stack: what `make size` prints as RAM+stack, within the 328P's 2 KiB
+    for row in rows:
+        if row["target"] == "avr":
+            static = sum(row[p][k] for p in ("codec", "skeleton", "firmware", "runtime") for k in ("data", "bss"))
+            assert 0 < static + row["stack"]["node"] < 2048, row

@@ -109,7 +109,7 @@ def identifiers(spec: Spec, vm: dict) -> Iterator[N.Ident]:
         yield N.Ident(SCOPE, mv.op_macro, at)
         for suffix in ("MIN_SIZE", "MAX_SIZE", "FRAME_MAX"):
             yield N.Ident(SCOPE, f"ARACHNAE_{mv.name}_{suffix}", at)
-        functions = ["validate", "build"] + (["decode", "check", "encode", "unpack"] if mv.has_fields else [])
+        functions = ["validate", "build"] + (["decode", "check", "encode", "unpack", "pack"] if mv.has_fields else [])
         for fn in functions:
             yield N.Ident(SCOPE, f"{mv.prefix}_{fn}", at)
         yield N.Ident("the generated C files", mv.file, at, is_file=True)
