@@ -19,20 +19,27 @@ Variant `spec`: the spec's collision rule, in one of two scopes:
   anyone may send again. Distinct ranks make collisions inside a window
   impossible, whether the requests are old or new.
 
-The reflex lead (spec arbitration.reflex_lead_bits, seed 5.2), variant `spec`:
-the request of the slave carrying a reflex record on this bus (the reflex's
-source, TPSC, or the master relaying its records up, SPU; `ArbParams.reflex`)
-starts reflex_lead_bits before any other on an idle line, so when it and other
-requests wait for the same idle line it goes alone and the others defer
-(`lead_X`). It can still collide: a request deferred to the end of a backoff
-window restarts on its timer, not on the line going idle, and meets a reflex
-request starting then (`collision` stays possible whenever several may send).
-The lead is bounded by the spec's rate: the source raises a reflex request at
-most once per reflexes.min_interval_ms (`reflex_gap_slots` whole slots, variable
-`rl`); without that bound the carrier could overtake a waiting slave forever.
-On a relay's bus the model assumes reflex records reach the relay that far
-apart as well (the hop below can bunch them); tracecheck's `reflex_rate` rule
-checks both the source's raise notes and the records' arrival at the relay.
+The reflex lead (spec arbitration.reflex_lead_bits, seed 5.2), variant `spec`,
+on the reflex source's bus (TPSC on the sensor bus, `ArbParams.reflex`): its
+request starts reflex_lead_bits before any other on an idle line, so when it
+and other requests wait for the same idle line it goes alone and the others
+defer and stay pending (`lead_X`). It can still collide: a request deferred to
+the end of a backoff window restarts on its timer, not on the line going idle,
+and meets a reflex request starting then (`collision` stays possible whenever
+several may send). The lead is bounded by the spec's rate: the source raises a
+reflex request at most once per reflexes.min_interval_ms (`reflex_gap_slots`
+whole slots, variable `rl`; tracecheck's `reflex_rate` rule checks the source's
+raise notes against it); without that bound the source could overtake a waiting
+slave forever (tests/model_check: a lasso through lead_X).
+
+Not on a relay's bus (the SPU carrying the TPSC's records on the first-level
+bus, `ArbParams.relay`): the spec bounds how often the source raises, not how
+often its records reach the relay -- the hop below bunches them (a run had two
+235 ms apart against min_interval 250 ms), so a lead there has no rate the
+checker could use. There the relay's lead is abstracted like every slave's
+rank stagger: requests waiting for the same idle line all start in that slot
+and collide, and the window serves them by rank; the relay ranks first anyway
+(buses.first.priority). tracecheck holds every trace to this model's K.
 
 The send rule (`send_guard`) and the backoff a collision sets
 (`collision_backoff`) are module-level so that the trace validator
@@ -77,9 +84,9 @@ def collision_backoff(p: ArbParams, rank: int) -> int:
 
 def lead_slave(p: ArbParams, variant: str, sl: list | None = None) -> int | None:
     """Index (among `sl`, default every slave) of the slave whose reflex requests lead on this bus (variant
-    spec, spec arbitration.reflex_lead_bits > 0 and a reflex path over the bus), else None."""
+    spec, spec arbitration.reflex_lead_bits > 0, the reflex's source on this bus), else None."""
     sl = p.slaves if sl is None else sl
-    if variant != "spec" or p.reflex is None:
+    if variant != "spec" or p.reflex is None or p.relay:
         return None
     return next((i for i, s in enumerate(sl) if s.short == p.reflex), None)
 
@@ -112,7 +119,6 @@ def build(p: ArbParams, variant: str, slaves: int | None = None) -> Model:
     maxrem = max(max(s.fetch_slots, s.deliver_slots) for s in sl)
     c = lead_slave(p, variant, sl)
     gap = p.reflex_gap_slots if c is not None else 0
-    relay = c is not None and p.relay
     vs: list[Var] = []
     for i, s in enumerate(sl):
         vs.append(Var(f"ph{i}", 2, doc=f"{s.short}: 0 idle, 1 record pending, 2 being served"))
@@ -125,8 +131,6 @@ def build(p: ArbParams, variant: str, slaves: int | None = None) -> Model:
     if gap:
         vs.append(Var("rl", gap, doc=f"slots before another reflex record may reach {sl[c].short} "
                                      f"(reflexes.min_interval_ms)"))
-    if relay:
-        vs.append(Var("lf", 1, doc=f"{sl[c].short}'s pending request carries a reflex record"))
     vs += [Var("mph", 2, doc="master: 0 listening, 1 fetching, 2 relaying"), Var("msrc", max(n - 1, 1)),
            Var("mrem", maxrem, doc="slots left in the current frame exchange"),
            Var("mdst", max(len(targets) - 1, 1)), Var("err", 1, doc="monitor: record lost or duplicated")]
@@ -149,35 +153,26 @@ def build(p: ArbParams, variant: str, slaves: int | None = None) -> Model:
     m = p.master
     rules: list[Rule] = []
     for i, s in enumerate(sl):
-        if i == c and gap and not relay:      # the source: every request carries a reflex, raised at most so often
+        if i == c and gap:                    # the source: every request carries a reflex, raised at most so often
             rules.append(Rule(f"arrive_{s.short}", f"ph{i} == {IDLE} and rl == 0",
                               ((f"ph{i}", str(PENDING)), ("rl", str(gap))),
                               actor=None, msc=(Event(s.short, None, "reflex record pending"),)))
             continue
         rules.append(Rule(f"arrive_{s.short}", f"ph{i} == {IDLE}", ((f"ph{i}", str(PENDING)),),
                           actor=None, msc=(Event(s.short, None, "record pending"),)))
-        if i == c and relay:                  # a reflex record reaches the relay: its request (or the one it
-            # already has pending) now carries it first; during a fetch it goes with that one (SPU outbox)
-            rules.append(Rule(f"arrive_{s.short}_reflex", "rl == 0" if gap else "True",
-                              ((f"ph{i}", f"{PENDING} if ph{i} == {IDLE} else ph{i}"),
-                               ("lf", f"0 if ph{i} == {SESSION} else 1")) + ((("rl", str(gap)),) if gap else ()),
-                              actor=None, msc=(Event(s.short, None, "reflex record pending"),)))
     rules.append(Rule("idle_slot", f"mph == {M_IDLE} and {nsend} == 0", tuple(tick_backoff(idle=True)),
                       actor="bus", ticks=1))
     for i, s in enumerate(sl):
         eff = [(f"ph{i}", str(SESSION)), ("mph", str(M_FETCH)), ("msrc", str(i)), ("mrem", str(s.fetch_slots))]
         if track:
             eff.append((f"col{i}", "0"))
-        if i == c and relay:
-            eff.append(("lf", "0"))
         rules.append(Rule(f"request_{s.short}", f"mph == {M_IDLE} and ({sends(i)}) and {nsend} == 1",
                           tuple(eff + tick_backoff(i, idle=True)), actor="bus", ticks=1,
                           msc=(Event(s.short, m, f"{p.request} (echo ok)"),)))
         if i == c:
             # spec arbitration.reflex_lead_bits: on an idle line the reflex request starts first, the others
             # hear its carrier and defer (they stay pending); the collision rule below remains possible too
-            rules.append(Rule(f"lead_{s.short}", f"mph == {M_IDLE} and ({sends(i)}) and {nsend} >= 2"
-                              + (" and lf == 1" if relay else ""),
+            rules.append(Rule(f"lead_{s.short}", f"mph == {M_IDLE} and ({sends(i)}) and {nsend} >= 2",
                               tuple(eff + tick_backoff(i, idle=True)), actor="bus", ticks=1,
                               msc=(Event(s.short, m, f"{p.request} (reflex, first: the others defer)"),)))
     coll: list[tuple[str, str]] = []

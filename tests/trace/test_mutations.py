@@ -5,9 +5,12 @@ from __future__ import annotations
 import re
 from dataclasses import replace
 
-from behaviours import mcp
+from behaviours import mcp, sensors
 from behaviours.runtime import BusTiming, Runtime
-from sim2d import runner
+from model_check.spec_adapter import load
+from sim2d import hardware, runner
+from tracecheck.trace import COLUMNS, parse_lines, trace_lines
+from tracecheck.validate import validate
 
 FIRST = re.compile(r"^(\d+\.\d{6}) s bus (\w+) \(trace line (\d+)\): (\w+): ")
 
@@ -69,3 +72,29 @@ def test_post_quorum_mutation_is_caught(monkeypatch, missing_scenario):
     assert (bus, rule) == ("debug", "post_verdict")
     assert "says HALTED" in out.result.metrics["protocol"]["first"] and "says DEGRADED" in \
         out.result.metrics["protocol"]["first"]
+
+
+def test_reflex_rate_limit_is_checked_and_its_mutation_is_caught(monkeypatch, missing_scenario):
+    """spec reflexes.min_interval_ms (250 ms), which bounds the arbitration model's reflex lead: a whisker whose
+    contact changes every 50 ms makes the TPSC raise as often as its limit lets it. The real code passes, with
+    the TPSC's raise notes checked; a 200 ms limit in the behaviour alone is caught at the second raise; a trace
+    without the notes (a capture) says the check was skipped."""
+    monkeypatch.setattr(hardware.NodeHardware, "whiskers",
+                        lambda self: (True, int(self.sched.now / 0.05) % 2 == 0))
+    out = runner.run(str(missing_scenario))
+    p = out.result.metrics["protocol"]
+    assert p["violations"] == 0, p["first"]
+    assert p["checked"]["reflex_rate"] >= 5 and p["skipped"] == {}
+    lines = ["\t".join(COLUMNS)] + trace_lines(out.result.frames)          # the frames, no debug rows
+    bare = validate(parse_lines(lines, "capture.tsv"), load()).metrics()
+    assert "TPSC" in bare["skipped"]["reflex_rate"] and "not checked" in bare["skipped"]["reflex_rate"]
+    start = sensors.TPSC.start
+
+    def faster(self):
+        start(self)
+        self.min_interval = 0.2
+    monkeypatch.setattr(sensors.TPSC, "start", faster)
+    mutated = runner.run(str(missing_scenario))
+    t, bus, rule = first(mutated)
+    assert (bus, rule) == ("debug", "reflex_rate") and "200.0 ms after the last" in \
+        mutated.result.metrics["protocol"]["first"]
