@@ -148,6 +148,11 @@ class Rules:
             self.buses[name] = r
 
 
+def heard_corrupt(f: TraceFrame) -> bool:
+    """Heard corrupt on the line (by every station, the sender's echo included), not lost."""
+    return f.heard is not None and not f.intact
+
+
 def _src(rules: Rules, f: TraceFrame) -> str | None:
     return rules.short.get(f.parsed.src) if f.parsed is not None else (f.sender or None)
 
@@ -187,7 +192,7 @@ class Validator:
             if self.timed:
                 self.one_talker(r, frames)
             else:                    # untimed: frames as they came, one after another
-                self.corrupt[bus] = [f for f in frames if f.heard is not None and not f.intact]
+                self.corrupt[bus] = [f for f in frames if heard_corrupt(f)]
             self.id_exchanges(r, frames)
             if r.arb is not None and self.timed:
                 self.arbitration(r, frames)
@@ -215,7 +220,7 @@ class Validator:
         for c in clusters:
             if len(c) == 1:
                 f = c[0]
-                if f.heard is not None and not f.intact:
+                if heard_corrupt(f):
                     corrupt.append(f)        # line noise: every station hears a corrupt frame
             else:
                 self.collided.update(f.line for f in c)
@@ -409,7 +414,9 @@ class Validator:
             if f.name != "ID_REQ":
                 continue
             node = self.dst(f)
-            n = len(self._id_run(r, frames, masters, pos, node))
+            # seed 3.2.2: an ID_REQ heard corrupt (its echo too) is sent again, which is no retry (the id_retry
+            # model's loss stands for it); a lost one is a try the node never heard, retried after the timeout
+            n = sum(1 for p in self._id_run(r, frames, masters, pos, node) if not heard_corrupt(frames[masters[p]]))
             self.report.checked["id_req"] += 1
             if n > attempts:
                 self.report.add(f, "id_retry", f"ID_REQ to {node}: attempt {n}, the spec allows "

@@ -43,6 +43,7 @@ static void request(uint16_t now)
     }
     st.requested = 1;
     st.requested_at = now;
+    hal_note(HAL_NOTE_REFLEX, 0);          /* debug port: raised now (tracecheck reflex_rate) */
     fw_announce(&st.slave, now, 1);
 }
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 from dataclasses import replace
 
+from arachnae_proto import messages as M
 from behaviours import mcp, sensors
 from behaviours.runtime import BusTiming, Runtime
 from model_check.spec_adapter import load
@@ -98,3 +99,27 @@ def test_reflex_rate_limit_is_checked_and_its_mutation_is_caught(monkeypatch, mi
     t, bus, rule = first(mutated)
     assert (bus, rule) == ("debug", "reflex_rate") and "200.0 ms after the last" in \
         mutated.result.metrics["protocol"]["first"]
+
+
+def test_corrupt_id_frames_pass_and_a_master_taking_one_for_an_answer_is_caught(monkeypatch, corrupt_id_scenario):
+    """The id_retry model counts a corrupt ID_REQ or ID_ACK as lost (its docstring says why); the validator's
+    id_retry / id_timeout rules hold the real exchange to it: the real code passes with ID frames heard corrupt,
+    and a master that takes a corrupt frame heard while it waits for an ID_ACK as the answer (no CRC check)
+    is caught at the first one, before the POST verdict it falsifies."""
+    out = runner.run(str(corrupt_id_scenario))
+    p = out.result.metrics["protocol"]
+    assert out.result.metrics["buses"]["sensor"]["corrupted"] > 0
+    assert p["violations"] == 0, p["first"]
+    on_codec_error = Runtime.on_codec_error
+
+    def no_crc_check(self, bus, err):
+        on_codec_error(self, bus, err)
+        link = self.links.get(bus)
+        req = link.current if link is not None else None
+        if req is not None and req.sent and M.IdAck in req.expect:
+            link.current = None
+            req.on_reply(req.dst, M.IdAck(address=req.dst))
+            self._next(link)
+    monkeypatch.setattr(Runtime, "on_codec_error", no_crc_check)
+    t, bus, rule = first(runner.run(str(corrupt_id_scenario)))
+    assert (bus, rule) == ("sensor", "id_retry") and t < 2.0
