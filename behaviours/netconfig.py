@@ -40,6 +40,7 @@ class Reflex:
     to: int
     command: str
     min_interval_s: float          # the source raises a reflex request at most this often
+    name: str = ""                 # nodes.yaml reflexes.name (the source's debug note names it)
 
 
 @dataclass(frozen=True)
@@ -81,7 +82,7 @@ class NetConfig:
             requesters={name: tuple(n.address for n in spec.requesters(name))
                         for name, b in spec.buses.items() if b.request_message},
             reflexes=tuple(Reflex(spec.node(r.source).address, spec.node(r.actor).address, spec.node(r.to).address,
-                                  r.command, r.min_interval_ms / 1000) for r in spec.reflexes),
+                                  r.command, r.min_interval_ms / 1000, r.name) for r in spec.reflexes),
             reflex_lead_bits=int(backoff["reflex_lead_bits"]) if backoff else 0,
             request_opcodes={name: spec.message(b.request_message).opcode
                              for name, b in spec.buses.items() if b.request_message},

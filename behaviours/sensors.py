@@ -281,6 +281,7 @@ class TPSC(Runtime, TpscSkeleton):
         self.master = ADDRESS_OF[BUSES[NODES[self.address].bus].master]   # the master of its bus
         reflex = self.net.reflex_from(self.address)
         self.min_interval = reflex.min_interval_s if reflex else 0.0
+        self.reflex_name = reflex.name if reflex else ""
         self.requested_at: float | None = None
         self.held = False
         self.every(T.TPSC_SCAN_S, self.scan)
@@ -304,6 +305,8 @@ class TPSC(Runtime, TpscSkeleton):
                 self.hw.after(wait, self._release)
             return
         self.requested_at = self.now
+        if self.min_interval:                    # debug port: when it was raised (tracecheck's reflex_rate rule)
+            self.hw.note("reflex_raised", reflex=self.reflex_name)
         self.slave_send(self.master, M.DataRdy())
 
     def _release(self) -> None:

@@ -60,8 +60,9 @@ uint16_t hal_line_quiet_ms(void);
 enum { HAL_SAMPLE_SONAR = 1, HAL_SAMPLE_IR = 2, HAL_SAMPLE_INCLINATION = 3, HAL_SAMPLE_TEMPERATURES = 4,
        HAL_SAMPLE_LIGHT = 5, HAL_SAMPLE_BATTERY = 6 };
 void hal_sample(uint8_t kind, uint16_t arg, int16_t *out, uint8_t n);
-/* A debug-port event (what a Python node writes with hw.note): kind, one argument. */
-enum { HAL_NOTE_STIMULUS = 0x40, HAL_NOTE_ALARM = 0x41, HAL_NOTE_STATUS = 0x42 };
+/* A debug-port event (what a Python node writes with hw.note): kind, one argument.
+ * NOTE_REFLEX: the reflex source raised a reflex request (tracecheck's reflex_rate rule). */
+enum { HAL_NOTE_STIMULUS = 0x40, HAL_NOTE_ALARM = 0x41, HAL_NOTE_STATUS = 0x42, HAL_NOTE_REFLEX = 0x43 };
 enum { HAL_STIMULUS_WHISKER = 0, HAL_STIMULUS_IR = 1 };
 void hal_note(uint8_t kind, uint16_t arg);
 

@@ -288,7 +288,7 @@ class SilNode:
 
     def _event(self, ev: tuple) -> None:
         if ev[0] == "a":
-            self._port(ev[2], ev[3])
+            self._port(ev[2], ev[3], self._time(ev[1]))
         elif ev[0] == "t":
             self._transmit(ev[1], ev[2])
         elif ev[0] == "p" and ev[2] == DE_PIN and ev[3] == 1:
@@ -298,7 +298,8 @@ class SilNode:
             self.hw.note("stimulus", kind="whisker")
 
     # -- sensor front end and debug port (hal.h) ----------------------------------
-    def _port(self, code: int, arg: int) -> None:
+    def _port(self, code: int, arg: int, at: float) -> None:
+        """A port request of the firmware made at time `at` (the simulator learns of it up to a sync later)."""
         sample, note = hal_enum("HAL_SAMPLE_"), hal_enum("HAL_NOTE_")
         if code in sample.values():
             self.host.reply(self._sample(next(k for k, v in sample.items() if v == code), arg))
@@ -310,6 +311,9 @@ class SilNode:
             self.hw.note("sensor_alarm", node=self.node.short, channels=[c for c in range(16) if arg >> c & 1])
         elif code == note["STATUS"]:
             self.hw.note("sensor_status", node=self.node.short, status=RangeStatus(arg).name)
+        elif code == note["REFLEX"]:
+            reflex = next(r for r in self.hw.sim.spec.reflexes if r.source == self.node.short)
+            self.hw.note("reflex_raised", reflex=reflex.name, at=at)
         else:
             raise SilError(f"{self.node.short}: unknown sensor port request {code:#04x}")
 

@@ -26,7 +26,7 @@ from model_check.engine import Result
 # CHOICE: injections start after POST and the sensor set-up, which take about 2 s in the simulator
 START_S = 3.0
 # the run goes on this many slots after the last injection: the master's own polls take about half of
-# them, and the rest must pass K of every contended bus (32-36 slots) for a starvation to show
+# them, and the rest must pass K of every contended bus (36 slots each) for a starvation to show
 RUN_SLOTS = 160
 
 

@@ -119,6 +119,22 @@ class ArbParams:
     max_collisions: int
     rule_section: str
     scope: str                # who defers after a collision: 'colliders' or 'all'
+    reflex: str | None = None     # the slave whose requests carry reflex records here (spec reflexes), if any
+    relay: bool = False           # ... which it relays from a bus below (SPU), rather than raises itself (TPSC)
+    reflex_gap_slots: int = 0     # whole slots between two reflex records reaching it (reflexes.min_interval_ms)
+    reflex_gap_ms: float = 0.0    # ... the spec's interval itself
+
+
+def reflex_carrier(spec, bus: str):
+    """(reflex, carrier on `bus`) for the reflex whose path runs over `bus`, or None: the carrier is the
+    reflex's source or the master relaying its records up the hierarchy towards the actor (seed 3.2.2, 5.2)."""
+    for r in spec.reflexes:
+        node = spec.node(r.source)
+        while node.short != r.actor and node.bus is not None:
+            if node.bus == bus:
+                return r, node
+            node = spec.node(spec.buses[node.bus].master)
+    return None
 
 
 def request_message(spec, bus: str) -> str:
@@ -168,9 +184,18 @@ def arbitration(spec, bus: str, scope: str | None = None) -> ArbParams:
         fetch, relay, target = record_route(spec, bus, n)
         slaves.append(ArbSlave(n.short, rank, slots(sum(frame_us(spec, bus, f) for f in fetch), slot_us),
                                slots(sum(frame_us(spec, bus, f) for f in relay), slot_us) if relay else 0, target))
-    return ArbParams(bus=bus, master=b.master, request=req, slot_us=slot_us, slaves=slaves,
-                     backoff_slots=int(rule["backoff_slots"]), max_collisions=int(rule["max_collisions_per_request"]),
-                     rule_section=rule.get("section", "3.2.2"), scope=scope or rule["backoff_scope"])
+    p = ArbParams(bus=bus, master=b.master, request=req, slot_us=slot_us, slaves=slaves,
+                  backoff_slots=int(rule["backoff_slots"]), max_collisions=int(rule["max_collisions_per_request"]),
+                  rule_section=rule.get("section", "3.2.2"), scope=scope or rule["backoff_scope"])
+    found = reflex_carrier(spec, bus)
+    if found is not None and int(rule.get("reflex_lead_bits", 0)) > 0:
+        # spec arbitration.reflex_lead_bits: the carrier's reflex request starts first on an idle line;
+        # reflexes.min_interval_ms: the source raises one at most this often, so they reach a slot apart
+        r, node = found
+        p.reflex, p.relay = node.short, node.short != r.source
+        p.reflex_gap_ms = float(r.min_interval_ms)
+        p.reflex_gap_slots = int(math.floor(r.min_interval_ms * 1000.0 / slot_us + 1e-9))
+    return p
 
 
 # -- identification -------------------------------------------------------------------

@@ -53,4 +53,6 @@ def _check(args: argparse.Namespace) -> int:
               f"requests {m['requests']} (served {m['served']}, declined {m['declined']}, unchecked {m['unchecked']}), "
               + (f"longest wait {m['max_wait_slots']} slots, K {m['k_slots']}" if not args.untimed else
                  f"untimed: checked {m['checked']}"))
+        for rule, why in m["skipped"].items():
+            print(f"{args.trace}: {rule} skipped: {why}")
     return 1 if report.violations else 0

@@ -23,8 +23,9 @@ from captures.decode import decode
 
 COLUMNS = ("start_s", "end_s", "bus", "sender", "src", "dst", "message", "bytes", "flags", "sent")
 DEBUG_BUS = "debug"
-# debug-port events the validator needs, as written by the nodes (behaviours' hw.note)
-PROTOCOL_NOTES = ("post_verdict",)
+# debug-port events the validator needs, as written by the nodes (behaviours' hw.note): the MCP's POST verdict
+# and the reflex source raising a reflex request (the line shows only when the request got on it)
+PROTOCOL_NOTES = ("post_verdict", "reflex_raised")
 LIST_SEP = ";"           # between names in a debug row (node names contain commas)
 
 
@@ -74,11 +75,16 @@ def note_message(event: str, **fields: object) -> str:
 
 
 def note_row(t: float, node: str, event: str, data: dict) -> str | None:
-    """A debug-port note as a trace row, when the protocol rules need it."""
-    if event != "post_verdict":
+    """A debug-port note as a trace row, when the protocol rules need it. `at` in a note's data is when the
+    node did it, if the simulator learnt of it later (a SIL node's notes arrive up to a sync period late)."""
+    if event == "post_verdict":
+        v = data["verdict"]
+        text = note_message(event, verdict=v.verdict, missing=LIST_SEP.join(v.missing) or "-")
+    elif event == "reflex_raised":
+        text = note_message(event, reflex=data["reflex"])
+    else:
         return None
-    v = data["verdict"]
-    text = note_message(event, verdict=v.verdict, missing=LIST_SEP.join(v.missing) or "-")
+    t = float(data.get("at", t))
     return "\t".join((f"{t:.6f}", f"{t:.6f}", DEBUG_BUS, node, "-", "-", text, "", "", ""))
 
 
@@ -93,11 +99,11 @@ def frame_row(start: float, end: float, bus: str, sender: str, sent: bytes, hear
 
 def trace_lines(frames: Iterable[Any], notes: Iterable[tuple[float, str, str, dict[str, Any]]] = ()) -> list[str]:
     """trace.tsv's rows for a run's frames (sim2d.bus.TraceEntry: start, end, bus, sender, sent, heard, flags)
-    in the order they ended, with the debug-port notes the protocol rules need (the POST verdict) as `debug`
+    in the order they ended, with the debug-port notes the protocol rules need (PROTOCOL_NOTES) as `debug`
     rows at their time. The message column is the generated codec's reading of the bytes heard
     (captures.decode); a frame it rejects shows the codec's reason."""
     rows = [(f.end, 1, frame_row(f.start, f.end, f.bus, f.sender, f.sent, f.heard, f.flags)) for f in frames]
-    rows += [(t, 0, row) for t, node, event, data in notes
+    rows += [(float(data.get("at", t)), 0, row) for t, node, event, data in notes
              if (row := note_row(t, node, event, data)) is not None]
     rows.sort(key=lambda r: (r[0], r[1]))
     return [row for _t, _k, row in rows]

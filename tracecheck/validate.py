@@ -17,7 +17,13 @@ What is checked, and where each rule comes from:
   (`post.expected_verdict`) over the nodes that answered on the wire;
 - MOVE_RELAYED resends follow protocol.move_retries; INIT is broadcast once
   after each POST that did not halt (seed 3.2.3); every record that reaches
-  the MCP is relayed to its target (seed 3.2.2: every datum runs through it).
+  the MCP is relayed to its target (seed 3.2.2: every datum runs through it);
+- the reflex rate that bounds the arbitration model's lead (spec reflexes.
+  min_interval_ms, `ArbParams.reflex_gap_ms`): the source's `reflex_raised`
+  debug notes (when it raised the request; the line shows only when the
+  request got on it) at least min_interval apart. A trace without those notes
+  (a capture has no debug port) says the check was skipped (`skipped` in the
+  report and a line of `arachnae trace check`), never passes it silently.
 A violation names the first offending frame by time, bus and trace line.
 """
 from __future__ import annotations
@@ -63,10 +69,13 @@ class Report:
     max_wait_slots: dict[str, float] = field(default_factory=dict)
     k_slots: dict[str, int | None] = field(default_factory=dict)
     checked: dict[str, int] = field(default_factory=lambda: defaultdict(int))
+    skipped: dict[str, str] = field(default_factory=dict)    # rule -> why it could not be checked on this trace
 
-    def add(self, f: TraceFrame | None, rule: str, text: str, t: float | None = None, bus: str | None = None) -> None:
+    def add(self, f: TraceFrame | None, rule: str, text: str, t: float | None = None, bus: str | None = None,
+            line: int | None = None) -> None:
+        """A violation at frame f, or (f None) at time t on `bus`, trace line `line` (a debug row)."""
         self.violations.append(Violation(f.start if t is None else t, f.bus if bus is None else bus,
-                                         f.line if f is not None else 0, rule, text))
+                                         line if line is not None else f.line if f is not None else 0, rule, text))
 
     def metrics(self) -> dict[str, Any]:
         first = min(self.violations, key=lambda v: (v.t, v.line)) if self.violations else None
@@ -77,7 +86,8 @@ class Report:
                 "by_rule": dict(sorted(by_rule.items())), "requests": self.requests, "served": self.served,
                 "declined": self.declined, "unchecked": self.unchecked, "starved": self.starved,
                 "max_wait_slots": {b: round(v, 2) for b, v in sorted(self.max_wait_slots.items())},
-                "k_slots": dict(sorted(self.k_slots.items())), "checked": dict(sorted(self.checked.items()))}
+                "k_slots": dict(sorted(self.k_slots.items())), "checked": dict(sorted(self.checked.items())),
+                "skipped": dict(sorted(self.skipped.items()))}
 
 
 @dataclass
@@ -145,6 +155,11 @@ class Rules:
             self.buses[name] = r
 
 
+def heard_corrupt(f: TraceFrame) -> bool:
+    """Heard corrupt on the line (by every station, the sender's echo included), not lost."""
+    return f.heard is not None and not f.intact
+
+
 def _src(rules: Rules, f: TraceFrame) -> str | None:
     return rules.short.get(f.parsed.src) if f.parsed is not None else (f.sender or None)
 
@@ -184,12 +199,14 @@ class Validator:
             if self.timed:
                 self.one_talker(r, frames)
             else:                    # untimed: frames as they came, one after another
-                self.corrupt[bus] = [f for f in frames if f.heard is not None and not f.intact]
+                self.corrupt[bus] = [f for f in frames if heard_corrupt(f)]
             self.id_exchanges(r, frames)
             if r.arb is not None and self.timed:
                 self.arbitration(r, frames)
         self.post_verdicts()
         self.first_bus_relays()
+        if self.timed:
+            self.reflex_rate()
         self.report.violations.sort(key=lambda v: (v.t, v.line))
         return self.report
 
@@ -210,7 +227,7 @@ class Validator:
         for c in clusters:
             if len(c) == 1:
                 f = c[0]
-                if f.heard is not None and not f.intact:
+                if heard_corrupt(f):
                     corrupt.append(f)        # line noise: every station hears a corrupt frame
             else:
                 self.collided.update(f.line for f in c)
@@ -404,7 +421,9 @@ class Validator:
             if f.name != "ID_REQ":
                 continue
             node = self.dst(f)
-            n = len(self._id_run(r, frames, masters, pos, node))
+            # seed 3.2.2: an ID_REQ heard corrupt (its echo too) is sent again, which is no retry (the id_retry
+            # model's loss stands for it); a lost one is a try the node never heard, retried after the timeout
+            n = sum(1 for p in self._id_run(r, frames, masters, pos, node) if not heard_corrupt(frames[masters[p]]))
             self.report.checked["id_req"] += 1
             if n > attempts:
                 self.report.add(f, "id_retry", f"ID_REQ to {node}: attempt {n}, the spec allows "
@@ -496,9 +515,7 @@ class Validator:
             if got != expect or missing != absent:
                 self.report.add(None, "post_verdict", f"{note.node} says {got} missing {sorted(missing) or '-'}; "
                                 f"the spec's rule over the nodes that answered says {expect} missing "
-                                f"{sorted(absent) or '-'}", t=note.t, bus="debug")
-                self.report.violations[-1] = Violation(note.t, "debug", note.line, "post_verdict",
-                                                       self.report.violations[-1].text)
+                                f"{sorted(absent) or '-'}", t=note.t, bus="debug", line=note.line)
         self.init_after_post(verdicts)
 
     def _present(self, answered: dict[str, bool], s: str) -> bool:
@@ -613,6 +630,32 @@ class Validator:
     @staticmethod
     def _applied(ack: M.StatusAckMmc, cmd: int) -> bool:
         return ack.gait == cmd if cmd in GAITS else ack.direction == cmd
+
+
+    # -- the reflex rate behind the arbitration model's lead ---------------------------------------
+    def reflex_rate(self) -> None:
+        """spec reflexes.min_interval_ms, the rate that bounds the arbitration model's reflex lead: the source's
+        `reflex_raised` notes at least that far apart."""
+        for r in self.rules.buses.values():
+            if r.arb is not None and arbitration.lead_slave(r.arb, self.rules.variants.get(r.name, "spec")) is not None:
+                self._raise_rate(r, r.arb)
+
+    def _raise_rate(self, r: BusRules, arb: spec_adapter.ArbParams) -> None:
+        notes = [n for n in self.trace.notes if n.event == "reflex_raised" and n.node == arb.reflex]
+        requests = [f for f in self.by_bus.get(r.name, []) if f.name == r.request and self.src(f) == arb.reflex]
+        if requests and not notes:
+            self.report.skipped["reflex_rate"] = (
+                f"{arb.reflex} sent {len(requests)} {r.request} on bus {r.name} but the trace has no reflex_raised "
+                f"note of it (no debug port in a capture, or a node that does not write it): its "
+                f"{arb.reflex_gap_ms:g} ms rate limit (spec reflexes.min_interval_ms) is not checked")
+            return
+        self.report.checked["reflex_rate"] += len(notes)
+        need = arb.reflex_gap_ms * 1e-3
+        for a, b in zip(notes, notes[1:]):
+            if b.t - a.t < need - 2e-6:        # two times read off the trace, each kept to the microsecond
+                self.report.add(None, "reflex_rate", f"{arb.reflex} raised a reflex request "
+                                f"{(b.t - a.t) * 1e3:.1f} ms after the last; spec reflexes.min_interval_ms is "
+                                f"{arb.reflex_gap_ms:g} ms", t=b.t, bus="debug", line=b.line)
 
 
 def validate(trace: Trace, spec: Any, variants: dict[str, str] | None = None, timed: bool = True) -> Report:

@@ -34,15 +34,17 @@ static uint8_t contact_code(uint8_t inputs)
 }
 
 /* DATA_RDY, at most once per the reflex's min_interval (spec reflexes): a contact sooner than that
-   is latched and goes with the next request; the STOP of the last one is already on its way (5.2) */
+   is latched and goes with the next request; the STOP of the last one is already on its way (5.2).
+   More than min_interval ticks: a millisecond tick began up to 1 ms after the last request */
 static void request(uint16_t now)
 {
-    if (st.requested && (uint16_t)(now - st.requested_at) < FW_REFLEX_MIN_INTERVAL_MS) {
+    if (st.requested && (uint16_t)(now - st.requested_at) <= FW_REFLEX_MIN_INTERVAL_MS) {
         st.held = 1;
         return;
     }
     st.requested = 1;
     st.requested_at = now;
+    hal_note(HAL_NOTE_REFLEX, 0);          /* debug port: raised now (tracecheck reflex_rate) */
     fw_announce(&st.slave, now, 1);
 }
 
@@ -103,7 +105,7 @@ void fw_behaviour_poll(void *vnode, uint16_t now)
         }
         st.contact = c;
     }
-    if (st.held && (uint16_t)(now - st.requested_at) >= FW_REFLEX_MIN_INTERVAL_MS) {
+    if (st.held && (uint16_t)(now - st.requested_at) > FW_REFLEX_MIN_INTERVAL_MS) {
         st.held = 0;
         if (st.latched)
             request(now);

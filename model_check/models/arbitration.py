@@ -19,6 +19,28 @@ Variant `spec`: the spec's collision rule, in one of two scopes:
   anyone may send again. Distinct ranks make collisions inside a window
   impossible, whether the requests are old or new.
 
+The reflex lead (spec arbitration.reflex_lead_bits, seed 5.2), variant `spec`,
+on the reflex source's bus (TPSC on the sensor bus, `ArbParams.reflex`): its
+request starts reflex_lead_bits before any other on an idle line, so when it
+and other requests wait for the same idle line it goes alone and the others
+defer and stay pending (`lead_X`). It can still collide: a request deferred to
+the end of a backoff window restarts on its timer, not on the line going idle,
+and meets a reflex request starting then (`collision` stays possible whenever
+several may send). The lead is bounded by the spec's rate: the source raises a
+reflex request at most once per reflexes.min_interval_ms (`reflex_gap_slots`
+whole slots, variable `rl`; tracecheck's `reflex_rate` rule checks the source's
+raise notes against it); without that bound the source could overtake a waiting
+slave forever (tests/model_check: a lasso through lead_X).
+
+Not on a relay's bus (the SPU carrying the TPSC's records on the first-level
+bus, `ArbParams.relay`): the spec bounds how often the source raises, not how
+often its records reach the relay -- the hop below bunches them (a run had two
+235 ms apart against min_interval 250 ms), so a lead there has no rate the
+checker could use. There the relay's lead is abstracted like every slave's
+rank stagger: requests waiting for the same idle line all start in that slot
+and collide, and the window serves them by rank; the relay ranks first anyway
+(buses.first.priority). tracecheck holds every trace to this model's K.
+
 The send rule (`send_guard`) and the backoff a collision sets
 (`collision_backoff`) are module-level so that the trace validator
 (tracecheck) evaluates the very same expressions on a simulated or captured
@@ -60,6 +82,15 @@ def collision_backoff(p: ArbParams, rank: int) -> int:
     return (rank + 1) * p.backoff_slots
 
 
+def lead_slave(p: ArbParams, variant: str, sl: list | None = None) -> int | None:
+    """Index (among `sl`, default every slave) of the slave whose reflex requests lead on this bus (variant
+    spec, spec arbitration.reflex_lead_bits > 0, the reflex's source on this bus), else None."""
+    sl = p.slaves if sl is None else sl
+    if variant != "spec" or p.reflex is None or p.relay:
+        return None
+    return next((i for i, s in enumerate(sl) if s.short == p.reflex), None)
+
+
 def send_guard(p: ArbParams, variant: str, i: int, rank: int, n: int) -> str:
     """When slave i (rank `rank`, one of n) may start its request, over ph{i}, bo{i} and since.
 
@@ -86,6 +117,8 @@ def build(p: ArbParams, variant: str, slaves: int | None = None) -> Model:
     targets = sorted({s.target for s in sl})
     tcode = {t: i for i, t in enumerate(targets)}
     maxrem = max(max(s.fetch_slots, s.deliver_slots) for s in sl)
+    c = lead_slave(p, variant, sl)
+    gap = p.reflex_gap_slots if c is not None else 0
     vs: list[Var] = []
     for i, s in enumerate(sl):
         vs.append(Var(f"ph{i}", 2, doc=f"{s.short}: 0 idle, 1 record pending, 2 being served"))
@@ -95,6 +128,9 @@ def build(p: ArbParams, variant: str, slaves: int | None = None) -> Model:
             vs.append(Var(f"col{i}", p.max_collisions + 1, doc=f"{s.short}: collisions of this request"))
     if window:
         vs.append(Var("since", W, init=W, doc="idle slots since the last collision (W: window over)"))
+    if gap:
+        vs.append(Var("rl", gap, doc=f"slots before another reflex record may reach {sl[c].short} "
+                                     f"(reflexes.min_interval_ms)"))
     vs += [Var("mph", 2, doc="master: 0 listening, 1 fetching, 2 relaying"), Var("msrc", max(n - 1, 1)),
            Var("mrem", maxrem, doc="slots left in the current frame exchange"),
            Var("mdst", max(len(targets) - 1, 1)), Var("err", 1, doc="monitor: record lost or duplicated")]
@@ -109,11 +145,19 @@ def build(p: ArbParams, variant: str, slaves: int | None = None) -> Model:
         out = [(f"bo{j}", f"max(bo{j} - 1, 0)") for j in range(n) if spec and j != skip]
         if window and idle:
             out.append(("since", f"min(since + 1, {W})"))
-        return out
+        return out + rate_tick()
+
+    def rate_tick() -> list[tuple[str, str]]:
+        return [("rl", "max(rl - 1, 0)")] if gap else []
 
     m = p.master
     rules: list[Rule] = []
     for i, s in enumerate(sl):
+        if i == c and gap:                    # the source: every request carries a reflex, raised at most so often
+            rules.append(Rule(f"arrive_{s.short}", f"ph{i} == {IDLE} and rl == 0",
+                              ((f"ph{i}", str(PENDING)), ("rl", str(gap))),
+                              actor=None, msc=(Event(s.short, None, "reflex record pending"),)))
+            continue
         rules.append(Rule(f"arrive_{s.short}", f"ph{i} == {IDLE}", ((f"ph{i}", str(PENDING)),),
                           actor=None, msc=(Event(s.short, None, "record pending"),)))
     rules.append(Rule("idle_slot", f"mph == {M_IDLE} and {nsend} == 0", tuple(tick_backoff(idle=True)),
@@ -125,6 +169,12 @@ def build(p: ArbParams, variant: str, slaves: int | None = None) -> Model:
         rules.append(Rule(f"request_{s.short}", f"mph == {M_IDLE} and ({sends(i)}) and {nsend} == 1",
                           tuple(eff + tick_backoff(i, idle=True)), actor="bus", ticks=1,
                           msc=(Event(s.short, m, f"{p.request} (echo ok)"),)))
+        if i == c:
+            # spec arbitration.reflex_lead_bits: on an idle line the reflex request starts first, the others
+            # hear its carrier and defer (they stay pending); the collision rule below remains possible too
+            rules.append(Rule(f"lead_{s.short}", f"mph == {M_IDLE} and ({sends(i)}) and {nsend} >= 2",
+                              tuple(eff + tick_backoff(i, idle=True)), actor="bus", ticks=1,
+                              msc=(Event(s.short, m, f"{p.request} (reflex, first: the others defer)"),)))
     coll: list[tuple[str, str]] = []
     for i, s in enumerate(sl):
         if track:
@@ -134,6 +184,7 @@ def build(p: ArbParams, variant: str, slaves: int | None = None) -> Model:
             coll.append((f"bo{i}", f"{collision_backoff(p, s.rank)} if ({sends(i)}) else max(bo{i} - 1, 0)"))
     if window:
         coll.append(("since", "0"))     # every slave heard the corrupt frame: a new window starts
+    coll += rate_tick()
     rules.append(Rule("collision", f"mph == {M_IDLE} and {nsend} >= 2", tuple(coll), actor="bus", ticks=1,
                       msc=(Event(m, None, f"{p.request} frames collide, every echo corrupt"),)))
     rules.append(Rule("busy_slot", f"mph != {M_IDLE} and mrem > 1", (("mrem", "mrem - 1"),) + tuple(tick_backoff()),

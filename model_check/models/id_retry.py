@@ -4,12 +4,32 @@ The master probes its slaves one after another in address order. One tick is
 one character time on the bus; frame, timeout and turnaround durations come
 from the spec in whole ticks (rounded up). The environment decides, on the
 first ID_REQ a node receives, whether it answers at all; every ID_REQ and
-every ID_ACK may be lost or corrupted (a corrupted frame fails its CRC and is
-dropped, so both look alike to the receiver; a late ACK colliding with the
-master's next ID_REQ is covered by that loss). A node that answers does so
-after any delay up to `max_delay_ticks`, so an ID_ACK may arrive after the
-timeout, after the retry went out, or after the master moved on to the next
-node -- and a node that receives both requests answers twice.
+every ID_ACK may be lost (a late ACK colliding with the master's next ID_REQ is
+covered by that loss). A node that answers does so after any delay up to
+`max_delay_ticks`, so an ID_ACK may arrive after the timeout, after the retry
+went out, or after the master moved on to the next node -- and a node that
+receives both requests answers twice.
+
+Corruption of ID_REQ / ID_ACK is abstracted as loss, and why: a corrupt frame
+fails its CRC and is dropped, so to its receiver it is a loss; what differs is
+only when the master talks next, which no property here depends on:
+- a corrupt ID_ACK: the master waits for it to end (the timeout runs to the
+  first byte, protocol.response_timeout_to) and, on a contended bus, for the
+  slaves' backoff window the corrupt frame opened (the arbitration model's
+  master only listens then), then retries as after a loss;
+- a corrupt ID_REQ: the node drops it (a loss to it); the master hears its
+  own echo corrupt and sends it again after that window (seed 3.2.2's echo
+  rule), without spending its retry. Here the loss spends it, so the model
+  declares a node inactive no later than the code does; repeated corruption
+  delays the round without bound (the code resends on every corrupt echo), so
+  `round_complete`'s tick bound holds for losses, not for a noisy line.
+tracecheck checks both on every trace: `id_retry` counts attempts without the
+echo resends (a resend after a corrupt echo is none) and demands a resend when
+no intact ID_ACK came; `id_timeout` holds the resend to the timeout and, after
+a corrupt frame, to the window (`_slaves_window_end`); the POST oracle counts
+only intact, timely ID_ACKs. tests/trace/test_mutations.py runs a POST with
+the sensor bus corrupting ID frames (0 violations) and a master that takes a
+corrupt frame for the ID_ACK (caught by id_retry).
 """
 from __future__ import annotations
 

@@ -96,6 +96,8 @@ def test_tpsc_initiates_and_resends_after_a_corrupt_echo(host_factory, spec):
     assert tx_bytes(ev) == frame.build(0x04, 0x28, messages.DataRdy())
     released = next(e[1] for e in ev if e[0] == "p" and e[2] == "D2" and e[3] == 0)
     assert any(e[0] == "p" and e[2] == "B5" and e[3] == 1 for e in ev)   # stimulus test point
+    from firmware.sil_bridge import hal_enum
+    assert any(e[0] == "a" and e[2] == hal_enum("HAL_NOTE_")["REFLEX"] for e in ev)   # raised: tracecheck reflex_rate
     h.set_pin("C2", 1)                                  # the line released: the bus reports a corrupt echo
     ev = run_like_the_bridge(h, h.cycle + 150 * MS)
     again = [e for e in ev if e[0] == "t"]
@@ -131,6 +133,8 @@ def test_high_obstacle_with_the_tpsc_in_simavr_behaves_like_the_python_run(firmw
     assert any(s.startswith("ID_ACK") for s in sent), sent
     assert any(s.startswith("XMIT_DATA_TPSC") for s in sent), sent
     assert sm["max_reaction_s"] is not None and sm["max_reaction_s"] <= 1.0
+    # the C TPSC writes the reflex_raised note too: its rate limit is checked, not skipped
+    assert sm["protocol"]["checked"].get("reflex_rate", 0) >= 1 and sm["protocol"]["skipped"] == {}, sm["protocol"]
 
 
 # ---- issue 15 part 3: the seven sensor controllers in C, the whole sensor bus as firmware ----------

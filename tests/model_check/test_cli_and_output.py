@@ -49,7 +49,7 @@ def test_timing_reports_the_scan_requirement_as_unmet(capsys):
 
 
 def test_mermaid_names_every_message_of_the_trace(spec):
-    res = explore(arbitration.build(sa.arbitration(spec, "sensor", "colliders"), "spec", 2), progress=False)
+    res = explore(arbitration.build(sa.arbitration(spec, "sensor", "colliders"), "spec", 3), progress=False)
     text = msc.to_mermaid(res, res.violation)
     steps = msc.to_json(res, res.violation)["steps"]
     for s in steps:

@@ -15,9 +15,10 @@ def test_seed_arbitration_collides_forever_with_two_slaves(spec):
 
 
 def test_spec_rule_as_written_lets_a_slave_collide_without_bound(spec):
-    """Only the colliders back off: a fresh request of a low rank keeps hitting the old one."""
+    """Only the colliders back off: a fresh request of a low rank keeps hitting the old one (three slaves: with
+    two, the TPSC's reflex lead alone separates them; IRRC and USRC have none)."""
     p = sa.arbitration(spec, "sensor", "colliders")
-    res = explore(arbitration.build(p, "spec", 2), progress=False)
+    res = explore(arbitration.build(p, "spec", 3), progress=False)
     assert res.violation is not None and res.violation.prop == "collisions_bounded"
 
 
@@ -115,3 +116,37 @@ def test_post_oracle_catches_a_wrong_quorum(spec):
     res = explore(model, progress=False)
     assert res.violation is not None and res.violation.kind == "final-check"
     assert "HALTED" in res.violation.detail
+
+
+def test_reflex_lead_is_modelled_with_the_collision_it_leaves(spec):
+    """spec arbitration.reflex_lead_bits: the TPSC's reflex request may go alone while others wait (lead_TPSC)
+    and may still collide with a deferred one restarting at the window's end (collision with TPSC sending).
+    Three slaves of the sensor bus keep it small."""
+    p = sa.arbitration(spec, "sensor")
+    assert p.reflex == "TPSC" and not p.relay and p.reflex_gap_slots == int(250_000 // p.slot_us)
+    model = arbitration.build(p, "spec", 3)
+    res = explore(model, progress=False)
+    assert res.ok, res.violation
+    assert "lead_TPSC" in [r.name for r in model.rules] and res.never_fired == []
+    lead = next(r for r in model.rules if r.name == "lead_TPSC")
+    coll = next(r for r in model.rules if r.name == "collision")
+    assert "nsend >= 2" in lead.guard and "nsend >= 2" in coll.guard     # both branches from the same state
+
+
+def test_reflex_lead_without_the_rate_limit_starves_the_others(spec):
+    """reflexes.min_interval_ms is what bounds the lead: a carrier allowed to raise reflex requests back to back
+    overtakes a waiting slave forever (a liveness lasso through lead_TPSC)."""
+    from dataclasses import replace
+    p = replace(sa.arbitration(spec, "sensor"), reflex_gap_slots=0)
+    res = explore(arbitration.build(p, "spec", 3), progress=False)
+    v = res.violation
+    assert v is not None and v.kind == "liveness" and v.prop != "served_TPSC"
+    assert "lead_TPSC" in [res.model.rules[s.rule].name for s in v.trace[v.loop_start + 1:]]
+
+
+def test_relay_bus_has_no_lead_rule(spec):
+    """The SPU relays the TPSC's records on the first-level bus, but the spec bounds only how often the TPSC
+    raises them, not how often they reach the SPU: no lead rule there (the model's docstring says why)."""
+    p = sa.arbitration(spec, "first")
+    assert p.reflex == "SPU" and p.relay and arbitration.lead_slave(p, "spec") is None
+    assert not any(r.name.startswith("lead_") for r in arbitration.build(p, "spec", 3).rules)

@@ -34,3 +34,13 @@ def replay_dir(tmp_path_factory) -> Path:
     assert p.returncode == 1, p.stderr            # the seed variant violates served_USRC
     assert "replay:" in p.stdout
     return out
+
+
+@pytest.fixture(scope="session")
+def corrupt_id_scenario(tmp_path_factory) -> Path:
+    """The missing-nodes POST with the sensor bus corrupting 40 % of its frames while the SPU identifies its
+    sensors: ID_REQs and ID_ACKs are heard corrupt (the seed 3.2.2 echo resend and the retry both happen)."""
+    p = tmp_path_factory.mktemp("scen") / "corrupt_id.yaml"
+    p.write_text(MISSING.replace("duration: 3", "duration: 2.5")
+                 + "faults:\n  - {at: 0.0, until: 2.0, bus: sensor, corrupt: 0.4}\n")
+    return p

@@ -169,3 +169,37 @@ def test_a_request_raised_during_post_is_counted_from_its_init(tmp_path):
     assert m["post"]["time_s"] > 0.65                          # the key came during the POST
     assert m["protocol"]["violations"] == 0, m["protocol"]["first"]
     assert m["protocol"]["served"] > 0 and m["nodes"]["UIC/RCP"]
+
+
+def check_table(table: list[list[str]]) -> dict[str, list[str]]:
+    """The violations' texts by rule."""
+    from model_check.spec_adapter import load
+    from tracecheck.trace import parse_lines
+    from tracecheck.validate import validate
+    out: dict[str, list[str]] = {}
+    for v in validate(parse_lines(["\t".join(r) for r in table], "t.tsv"), load()).violations:
+        out.setdefault(v.rule, []).append(v.text)
+    return out
+
+
+def test_what_the_models_leave_out_is_caught_on_the_trace(saved):
+    """Issue 11 section 4: the broadcast INIT after POST (post model docstring) and record forwarding through the
+    MCP (arbitration model docstring) are abstracted in the models; the validator's init_after_post and
+    record_relayed rules catch a trace that breaks them."""
+    table = rows(saved / "trace.tsv")
+    assert check_table(table) == {}
+    init = next(i for i, r in enumerate(table) if r[2] == "first" and r[6] == "INIT" and r[5] == "ALL")
+    twice = table[:init + 1] + [table[init][:]] + table[init + 1:]
+    gap = float(table[init][1]) - float(table[init][0]) + 0.05
+    twice[init + 1][0], twice[init + 1][1] = (f"{float(table[init][k]) + gap:.6f}" for k in (0, 1))
+    m = check_table(twice)
+    assert len(m["init_after_post"]) == 1 and "INIT broadcast 2 time(s)" in m["init_after_post"][0], m
+    # the MCP drops the first record it fetches (no DATA to its target); a later frame gives it the rule's 2 s
+    rec = next(i for i, r in enumerate(table) if r[2] == "first" and r[6].startswith("XMIT_RECORD"))
+    want = table[rec][6].split("source=")[1].split()[0:3]
+    relay = next(i for i, r in enumerate(table[rec:], rec) if r[3] == "MCP" and r[6].startswith("DATA")
+                 and r[6].split()[1:4] == [f"address={want[0]}", want[1], want[2]])
+    late = table[-1][:]
+    late[0], late[1] = (f"{float(late[k]) + 3:.6f}" for k in (0, 1))
+    m = check_table(table[:relay] + table[relay + 1:] + [late])
+    assert list(m) == ["record_relayed"] and "never relayed by the MCP" in m["record_relayed"][0], m
