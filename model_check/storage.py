@@ -380,13 +380,15 @@ class StateStore:
             cache: dict[str, np.ndarray] = {}
             words = self._unpack(self.keys.view[lo:hi])
 
-            def name(n: str, words=words, cache=cache) -> np.ndarray:
+            def name(n: str) -> np.ndarray:
                 if n not in cache:
                     cache[n] = (_eval(define[n], name) if n in define
                                 else _bits(words, layout.shift[n], layout.width[n]))
                 return cache[n]
             yield lo, hi, [_eval(node, name) for node in nodes]
-            cache.clear()          # `name` refers to itself: free the fields now, not at the next gc
+            # `name` refers to itself (a cycle the gc frees late): free what it holds now
+            cache.clear()
+            words = None
 
 
 def _bits(words: np.ndarray, shift: int, width: int) -> np.ndarray:
