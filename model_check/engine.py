@@ -20,7 +20,7 @@ import numpy as np
 from model_check.compile import Compiled, RangeError, compile_model
 from model_check.gcl import Model
 from model_check.liveness import check_responses
-from model_check.native import HIT_DEADLOCK, HIT_INVARIANT, HIT_RANGE, Native
+from model_check.native import HIT_RANGE, Native
 from model_check.storage import Meter, StateStore
 from model_check.trace import Step, Violation, concretise, follow
 
@@ -215,10 +215,9 @@ def _layer_native(model: Model, store: StateStore, frontier: np.ndarray, lo: int
         new.append(chunk.distinct[fresh])
         a += chunk.done
         if chunk.kind == HIT_RANGE:
-            raise RangeError(f"{model.rules[chunk.rule].name}: {model.vars[chunk.var].name} = {chunk.value}")
-        if chunk.kind in (HIT_INVARIANT, HIT_DEADLOCK):
-            hit = ("invariant", chunk.index, None) if chunk.kind == HIT_INVARIANT else ("deadlock", -1, None)
-            return new, (hit, lo + a)
+            raise RangeError(chunk.range_message(model))
+        if chunk.hit() is not None:
+            return new, (chunk.hit(), lo + a)
     return (np.concatenate(new) if new else frontier[:0]), None
 
 

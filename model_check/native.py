@@ -251,6 +251,16 @@ class Chunk:
     var: int = -1
     value: int = 0
 
+    def hit(self, state: int | None = None) -> tuple | None:
+        """The violation as the Python `edges` reports it: (kind, index, state), or None."""
+        if self.kind == HIT_INVARIANT:
+            return ("invariant", self.index, state)
+        return ("deadlock", -1, state) if self.kind == HIT_DEADLOCK else None
+
+    def range_message(self, model: Model) -> str:
+        """HIT_RANGE: the RangeError's text, as the Python `edges` words it."""
+        return f"{model.rules[self.rule].name}: {model.vars[self.var].name} = {self.value}"
+
 
 class Native:
     """A compiled model: `expand(rows)` runs the C function over a slice of frontier rows."""

@@ -306,6 +306,14 @@ class StateStore:
         _, new = self._insert_distinct(self.to_words(distinct))
         return [distinct[i] for i in new.tolist()]
 
+    def add_rows(self, rows: np.ndarray) -> np.ndarray:
+        """`add_states` for uint64 word rows: the new ones (in sorted order, not first-seen)."""
+        if not len(rows):
+            return rows
+        reps = np.unique(rows, axis=0)
+        _, new = self._insert_distinct(reps)
+        return reps[new]
+
     def _insert_distinct(self, reps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """For distinct rows `reps`: the id of each (stored or newly given) and which are new."""
         # probe the table: existing ids, or a mark (-2 - k) claiming a free slot for new key k
