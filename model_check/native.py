@@ -44,7 +44,7 @@ from model_check.gcl import Model
 
 CC_FLAGS = ("-O1", "-shared", "-fPIC", "-std=c99", "-w")
 HIT_NONE, HIT_INVARIANT, HIT_DEADLOCK, HIT_RANGE, HIT_FULL = 0, 1, 2, 3, 4
-MAX_EDGES = 1 << 18       # edges per call at most: bounds the buffers (about 12 MB for 3-word states)
+MAX_EDGES = 1 << 16       # edges per call at most: bounds the buffers (about 3 MB for 3-word states)
 
 
 class Unsupported(Exception):
