@@ -310,7 +310,11 @@ class StateStore:
         """`add_states` for uint64 word rows: the new ones (in sorted order, not first-seen)."""
         if not len(rows):
             return rows
-        reps = np.unique(rows, axis=0)
+        # distinct rows: sorted by their words (lexsort is a few times faster than unique(axis=0))
+        reps = rows[np.lexsort(rows.T[::-1])]
+        keep = np.ones(len(reps), bool)
+        keep[1:] = (reps[1:] != reps[:-1]).any(axis=1)
+        reps = reps[keep]
         _, new = self._insert_distinct(reps)
         return reps[new]
 
