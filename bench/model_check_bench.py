@@ -63,7 +63,7 @@ def main() -> None:
     bps = bytes_per_state(reference(small))
     sp = spin.run(promela.emit(model), depth_limit=max(100_000, 2 * ours.states), hash_bits=max(18, ours.states.bit_length() + 1))
     print(f"reference model: {model.name}")
-    print(f"{'':22}{'ours (CPython)':>18}{'SPIN (pan -DNOREDUCE)':>24}")
+    print(f"{'':22}{'ours (numpy + C)':>18}{'SPIN (pan -DNOREDUCE)':>24}")
     print(f"{'states':22}{ours.states:>18,}{sp.stored:>24,}")
     print(f"{'transitions':22}{ours.transitions:>18,}{sp.transitions:>24,}")
     print(f"{'search time (s)':22}{wall:>18.2f}{sp.seconds:>24.2f}")

@@ -66,7 +66,7 @@ def fit(ns: list[int], values: list[float]) -> float:
 
 
 def table(family: str, ns: list[int], use_spin: bool) -> None:
-    print(f"\n{family}: ours = CPython search (CPU s), SPIN = pan -DSAFETY -DNOREDUCE [-DCOLLAPSE] (pan s)")
+    print(f"\n{family}: ours = our search, C successor function (CPU s), SPIN = pan -DSAFETY -DNOREDUCE [-DCOLLAPSE] (pan s)")
     head = f"{'n':>3}{'states':>12}{'ours s':>9}{'ours MB':>9}{'B/st':>7}"
     if use_spin:
         head += f"{'spin s':>9}{'spin MB':>9}{'coll s':>9}{'coll MB':>9}{'t/spin':>8}{'t/coll':>8}{'m/spin':>8}{'m/coll':>8}"

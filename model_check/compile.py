@@ -13,9 +13,10 @@ liveness) still use that plain scheme.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cache
 from typing import Callable
 
-from model_check import expr, fastgen
+from model_check import expr, fastgen, native
 from model_check.gcl import Model
 
 
@@ -58,6 +59,7 @@ class Compiled:
     predicates: dict[str, Callable[[int], bool]]
     source: str
     edges: Callable | None = None   # (frontier, nxt, rules, ends) -> hit: one layer's edges (storage)
+    native: Callable[[], native.Native | None] = lambda: None   # the C successor function, built on first call
 
 def _unpack_lines(model: Model, lay: Layout, indent: str, src: str = "s") -> list[str]:
     return _var_lines(model, lay, indent, src) + [
@@ -160,7 +162,9 @@ def compile_model(model: Model, optimise: bool = True) -> Compiled:
     return Compiled(layout=lay, init=namespace["canon"](init), init_raw=init, expand=namespace["expand"],
                     successors=namespace["successors"], canon=namespace["canon"],
                     predicates={k: namespace[f"pred_{k}"] for k in preds}, source=source,
-                    edges=namespace["edges"])
+                    edges=namespace["edges"],
+                    native=cache(lambda: native.build(model, lay.shift, lay.width, lay.total_bits)) if optimise
+                    else (lambda: None))
 
 def _reference_expand(model: Model, lay: Layout, sym: bool, edges: bool = False) -> list[str]:
     """The straightforward `expand`: decode everything, every guard in turn, one set lookup per edge

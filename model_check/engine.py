@@ -9,18 +9,23 @@ on the stored graph without expanding any state again.
 """
 from __future__ import annotations
 
+import os
 import sys
 import time
 from dataclasses import dataclass, field
 from typing import TextIO
 
-from model_check.compile import Compiled, compile_model
+import numpy as np
+
+from model_check.compile import Compiled, RangeError, compile_model
 from model_check.gcl import Model
 from model_check.liveness import check_responses
+from model_check.native import HIT_RANGE, Native
 from model_check.storage import Meter, StateStore
 from model_check.trace import Step, Violation, concretise, follow
 
 SLICE = 1 << 15          # frontier states expanded per call of the generated `edges`
+NATIVE_AFTER = 1 << 13   # states searched in Python before the compiled successor function takes over
 
 __all__ = ["Result", "Step", "Violation", "explore", "trace_to", "concretise", "follow", "depth_of"]
 
@@ -120,37 +125,14 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
     t0, c0 = time.perf_counter(), time.process_time()
     store = StateStore(comp.layout.total_bits, len(model.rules))
     store.add_initial(comp.init)
-    frontier, lo = [comp.init], 0
     res.layer_starts = [0, 1]
-    hit = None
-    edges = comp.edges
-    while frontier:
-        # a wide layer goes in slices: the successor lists and their dedup dicts are the search's
-        # biggest Python objects; slicing changes nothing (the table dedups across slices, and ids,
-        # parents and the next frontier come out in the same first-seen order)
-        new = []
-        for a in range(0, len(frontier), SLICE):
-            nxt: list[int] = []
-            rules: list[int] = []
-            ends: list[int] = []
-            hit = edges(frontier[a:a + SLICE], nxt, rules, ends)
-            new += store.add_layer(lo + a, nxt, rules, ends)
-            if hit is not None:
-                hit_id = lo + a + len(ends)
-                break
-        if hit is not None:
-            break
-        lo += len(frontier)
-        frontier = new
-        if frontier:
-            res.layer_starts.append(lo + len(frontier))
-        if bar:
-            bar.update(len(res.layer_starts) - 2, len(store), len(frontier))
+    hit, hit_id = _search(model, comp, store, res.layer_starts, bar, res.times)
     res.store_bytes = store.nbytes         # before finish drops the hash table: the search's peak
     store.finish()
     res.store = store
     res.seconds = time.perf_counter() - t0
-    res.times["search"] = time.process_time() - c0     # CPU seconds: comparable on a busy machine
+    # CPU seconds: comparable on a busy machine
+    res.times = {"search": time.process_time() - c0, **res.times}
     res.coverage = store.coverage()
     res.states, res.transitions, res.depth = len(store), sum(res.coverage), len(res.layer_starts) - 2
     try:
@@ -173,19 +155,120 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
         res.cpu = time.process_time() - c0
 
 
+def _search(model: Model, comp: Compiled, store: StateStore, layer_starts: list[int], bar: Progress | None,
+            times: dict[str, float]) -> tuple[tuple | None, int]:
+    """Breadth-first layers; (hit, id of the hit state) or (None, -1).
+
+    Layers start on the generated Python `edges`; once the search has NATIVE_AFTER states it
+    goes on with the compiled C successor function (model_check.native), if there is one: a
+    small model never pays for a compiler run, a big one gets C speed. Both give the same ids,
+    parents, edges and hits, so where the switch happens changes no result."""
+    frontier: list[int] | np.ndarray = [comp.init]
+    lo, nat, tried = 0, None, False
+    while len(frontier):
+        if nat is None and not tried and len(store) >= NATIVE_AFTER:
+            tried, before = True, _child_cpu()
+            nat = comp.native()
+            times["compile"] = _child_cpu() - before      # the C compiler's CPU (0 when it was cached)
+            if nat is not None:
+                frontier = store.to_words(frontier)
+        new, hit = (_layer_native(model, store, frontier, lo, nat) if nat is not None
+                    else _layer_python(comp, store, frontier, lo))
+        if hit is not None:
+            return hit
+        lo += len(frontier)
+        frontier = new
+        _next_layer(store, layer_starts, bar, lo, len(frontier))
+    return None, -1
+
+
+def _child_cpu() -> float:
+    t = os.times()
+    return t.children_user + t.children_system
+
+
+def _layer_python(comp: Compiled, store: StateStore, frontier: list[int], lo: int):
+    """One layer with the generated Python `edges`: (next frontier, None) or (_, (hit, hit id))."""
+    new: list[int] = []
+    # a wide layer goes in slices: the successor lists and their dedup dicts are the search's
+    # biggest Python objects; slicing changes nothing (the table dedups across slices, and ids,
+    # parents and the next frontier come out in the same first-seen order)
+    for a in range(0, len(frontier), SLICE):
+        nxt: list[int] = []
+        rules: list[int] = []
+        ends: list[int] = []
+        hit = comp.edges(frontier[a:a + SLICE], nxt, rules, ends)
+        new += store.add_layer(lo + a, nxt, rules, ends)
+        if hit is not None:
+            return new, (hit, lo + a + len(ends))
+    return new, None
+
+
+def _layer_native(model: Model, store: StateStore, frontier: np.ndarray, lo: int, nat: Native):
+    """One layer with the C successor function, a call at a time (a call stops when its buffers
+    are full): (next frontier rows, None) or (_, (hit, hit id))."""
+    new: list[np.ndarray] = []
+    a = 0
+    while a < len(frontier):
+        chunk = nat.expand(frontier[a:a + SLICE])
+        fresh = store.add_edges(lo + a, chunk.distinct, chunk.inv, chunk.rules, chunk.ends)
+        new.append(chunk.distinct[fresh])
+        a += chunk.done
+        if chunk.kind == HIT_RANGE:
+            raise RangeError(chunk.range_message(model))
+        if chunk.hit() is not None:
+            return new, (chunk.hit(), lo + a)
+    return (np.concatenate(new) if new else frontier[:0]), None
+
+
+def _next_layer(store: StateStore, layer_starts: list[int], bar: Progress | None, lo: int, width: int) -> None:
+    if width:
+        layer_starts.append(lo + width)
+    if bar:
+        bar.update(len(layer_starts) - 2, len(store), width)
+
+
 def _final_checks(res: Result) -> None:
-    """Python-only checks (e.g. an oracle) on every state satisfying the model's `final`."""
+    """Python-only checks (e.g. an oracle) on every state satisfying the model's `final`.
+
+    With a `final_view`, a check sees only the view's values; with a `final_screen` too, the views
+    of all final states are computed on the stored graph in bulk (numpy) and screened at once, and
+    only the flagged states go through the checks, in id order: the first violation is at the
+    state a check of every final state in id order finds (issue 12: no second pass in Python)."""
     comp, model, store = res.compiled, res.model, res._graph()
     final = store.mask(comp.layout, model.defs, model.final)
     final[res.layer_starts[-1]:] = False
-    for i in final.nonzero()[0].tolist():
-        values = comp.layout.unpack(store.state(i))
-        for name, check in model.final_checks:
-            problem = check(values)
-            if problem:
-                res.violation = Violation("final-check", name,
-                                          concretise(comp, store.states(store.path_to(i))), detail=problem)
+    if not model.final_view:
+        for i in final.nonzero()[0].tolist():
+            if _final_violation(res, comp.layout.unpack(store.state(i)), i):
                 return
+        return
+    names = [name for name, _ in model.final_view]
+    texts = [text for _, text in model.final_view]
+    for lo, hi, values in store.evaluate(comp.layout, model.defs, texts, chunk=1 << 16):   # 40 columns: small chunks
+        ids = np.flatnonzero(final[lo:hi])
+        if not ids.size:
+            continue
+        view = {n: np.broadcast_to(np.asarray(v, np.int64), (hi - lo,))[ids] for n, v in zip(names, values)}
+        flagged = np.flatnonzero(model.final_screen(view)) if model.final_screen else range(len(ids))
+        for j in flagged:
+            if _final_violation(res, {n: int(view[n][j]) for n in names}, lo + int(ids[j])):
+                return
+            if model.final_screen:
+                raise RuntimeError(f"{model.name}: the final screen flags state {lo + int(ids[j])}, "
+                                   "the final checks pass it")
+
+
+def _final_violation(res: Result, values: dict[str, int], i: int) -> bool:
+    """Run the final checks on `values` (of state `i`); record the first problem as the violation."""
+    for name, check in res.model.final_checks:
+        problem = check(values)
+        if problem:
+            store = res._graph()
+            res.violation = Violation("final-check", name,
+                                      concretise(res.compiled, store.states(store.path_to(i))), detail=problem)
+            return True
+    return False
 
 
 def depth_of(res: Result, state: int) -> int:

@@ -8,7 +8,7 @@ comparable with ours.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Any, Callable
 
 from model_check import expr
 
@@ -88,6 +88,11 @@ class Model:
     symmetry: list[SymGroup] = field(default_factory=list)
     # Final-state checks written in Python (e.g. an independent oracle); our checker only.
     final_checks: list[tuple[str, Callable[[dict[str, int]], str | None]]] = field(default_factory=list)
+    # What the final checks see, as (name, expression) pairs (default: every variable), and the checks
+    # in bulk: view arrays of many final states -> True where a check reports a problem. The engine
+    # screens every final state with it and runs `final_checks` (for the message) on those it flags.
+    final_view: list[tuple[str, str]] = field(default_factory=list)
+    final_screen: Callable[[dict[str, Any]], Any] | None = None
     tick_us: float = 0.0                     # duration of one tick, for reporting bounds
     bound_ms: float | None = None            # the spec's bound on the responses' worst case (requirements)
     bound_section: str = ""
@@ -137,6 +142,8 @@ class Model:
         for inv in self.invariants:
             check(inv.expr, inv.name)
         check(self.final, "final")
+        for name, text in self.final_view:
+            check(text, f"final view {name}")
         for resp in self.responses:
             check(resp.trigger, resp.name)
             check(resp.goal, resp.name)

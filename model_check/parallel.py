@@ -26,8 +26,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from model_check.compile import Compiled, compile_model
-from model_check.engine import Progress, Result, explore
+from model_check.compile import Compiled, RangeError, compile_model
+from model_check.engine import SLICE, Progress, Result, explore
+from model_check.native import HIT_RANGE, Native
 from model_check.gcl import Model
 from model_check.storage import Meter, StateStore, mix64
 
@@ -46,21 +47,29 @@ def _owners(store: StateStore, states: list[int], workers: int) -> np.ndarray:
     return (mix64(store.to_words(states)) % np.uint64(workers)).astype(np.int64)
 
 
-def _worker(me: int, workers: int, comp: Compiled, rules: int, conn) -> None:
-    """One partition: dedup what arrives, expand what is new, ship successors to their owners."""
+def _worker(me: int, workers: int, model: Model, comp: Compiled, conn, nat: Native | None = None) -> None:
+    """One partition: dedup what arrives, expand what is new, ship successors to their owners.
+    States travel as uint64 word rows with the C successor function (`nat`), as ints without."""
     meter = Meter()
+    rules = len(model.rules)
     store = StateStore(comp.layout.total_bits, rules)
-    incoming = [comp.init] if int(_owners(store, [comp.init], workers)[0]) == me else []
+    init = store.to_words([comp.init])
+    mine = int((mix64(init) % np.uint64(workers))[0]) == me
+    incoming: list[int] | np.ndarray = (init if mine else init[:0]) if nat else ([comp.init] if mine else [])
     while True:
-        new = store.add_states(incoming)
-        nxt: list[int] = []
-        rule: list[int] = []
-        ends: list[int] = []
-        hit = comp.edges(new, nxt, rule, ends) if new else None
-        cov = np.bincount(np.asarray(rule, np.int64), minlength=rules)
-        conn.send(_Layer(len(new), len(nxt), cov, hit))
-        owner = _owners(store, nxt, workers) if nxt else np.zeros(0, np.int64)
-        buckets = [[nxt[i] for i in np.flatnonzero(owner == j).tolist()] for j in range(workers)]
+        if nat is None:
+            new: list[int] | np.ndarray = store.add_states(incoming)
+            nxt, rule, ends = [], [], []
+            hit = comp.edges(new, nxt, rule, ends) if new else None
+            edges, cov, out = len(nxt), np.bincount(np.asarray(rule, np.int64), minlength=rules), nxt
+            owner = _owners(store, nxt, workers) if nxt else np.zeros(0, np.int64)
+            buckets = [[nxt[i] for i in np.flatnonzero(owner == j).tolist()] for j in range(workers)]
+        else:
+            new = store.add_rows(incoming)
+            out, edges, cov, hit = _expand_rows(model, nat, new, rules)
+            owner = (mix64(out) % np.uint64(workers)).astype(np.int64)
+            buckets = [out[owner == j] for j in range(workers)]
+        conn.send(_Layer(len(new), edges, cov, hit))
         for j in range(workers):
             if j != me:
                 conn.send_bytes(pickle.dumps(buckets[j], pickle.HIGHEST_PROTOCOL))
@@ -68,10 +77,25 @@ def _worker(me: int, workers: int, comp: Compiled, rules: int, conn) -> None:
             conn.send((meter.peak(), store.nbytes))
             conn.close()
             return
-        incoming = buckets[me]
-        for j in range(workers):
-            if j != me:
-                incoming += pickle.loads(conn.recv_bytes())
+        parts = [buckets[me]] + [pickle.loads(conn.recv_bytes()) for j in range(workers) if j != me]
+        incoming = np.concatenate(parts) if nat else [s for part in parts for s in part]
+
+
+def _expand_rows(model: Model, nat: Native, new: np.ndarray, rules: int):
+    """A worker's layer on the C successor function: (distinct successors of each call, edges,
+    coverage, hit) -- up to the first violation, like the Python `edges`."""
+    outs, edges, cov, a = [], 0, np.zeros(rules, np.int64), 0
+    while a < len(new):
+        chunk = nat.expand(new[a:a + SLICE])
+        outs.append(chunk.distinct)
+        edges += len(chunk.inv)
+        cov += np.bincount(chunk.rules, minlength=rules)
+        a += chunk.done
+        if chunk.kind == HIT_RANGE:
+            raise RangeError(chunk.range_message(model))
+        if chunk.hit() is not None:
+            return np.concatenate(outs), edges, cov, chunk.hit(int.from_bytes(new[a].astype("<u8").tobytes(), "little"))
+    return (np.concatenate(outs) if outs else new[:0]), edges, cov, None
 
 
 def explore_parallel(model: Model, workers: int = 2, compiled: Compiled | None = None,
@@ -86,11 +110,12 @@ def explore_parallel(model: Model, workers: int = 2, compiled: Compiled | None =
     meter = Meter()
     bar = Progress(model.name) if progress else None
     t0, c0, ch0 = time.perf_counter(), time.process_time(), _children_cpu()
+    nat = comp.native()            # compiled once, before the fork: every worker inherits it
     ctx = mp.get_context("fork")
     conns, procs = [], []
     for w in range(workers):
         mine, theirs = ctx.Pipe()
-        p = ctx.Process(target=_worker, args=(w, workers, comp, len(model.rules), theirs), daemon=True)
+        p = ctx.Process(target=_worker, args=(w, workers, model, comp, theirs, nat), daemon=True)
         p.start()
         theirs.close()
         conns.append(mine)

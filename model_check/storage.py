@@ -265,22 +265,29 @@ class StateStore:
     def add_layer(self, lo: int, nxt: list[int], rules: list[int], ends: list[int]) -> list[int]:
         """Record the edges of the states lo .. lo+len(ends)-1 (see fastgen `edges`) and
         return the new states, in first-seen order (their ids follow the stored ones)."""
-        ends_a = np.asarray(ends, np.int64)
-        if len(ends_a):
-            deg = np.diff(ends_a, prepend=0)
-            if deg.max() > 0xFFFF:     # pragma: no cover - a state with 65536 successors
-                raise OverflowError("more than 65535 successors of one state")
-            self.degree.append(deg.astype(np.uint16))
-        if not nxt:
-            return []
-        self.rule.append(np.asarray(rules, self.rule.data.dtype))
         # distinct successors of this layer in first-seen order (a dict keeps insertion order),
         # and for each edge the number of its successor among them
         distinct = list(dict.fromkeys(nxt))
         number = dict(zip(distinct, range(len(distinct))))
         inv = np.fromiter(map(number.__getitem__, nxt), np.int64, len(nxt))
         del number
-        ids, new = self._insert_distinct(self.to_words(distinct))
+        new = self.add_edges(lo, self.to_words(distinct) if distinct else None, inv, rules, ends)
+        return [distinct[i] for i in new.tolist()]
+
+    def add_edges(self, lo: int, distinct: np.ndarray | None, inv: np.ndarray, rules, ends) -> np.ndarray:
+        """Record the edges of the states lo .. lo+len(ends)-1: `ends` (edges so far after each
+        state), per edge its rule and `inv`, the index of its successor among `distinct` (uint64
+        word rows, first-seen order). Returns the indices among `distinct` of the new states."""
+        ends_a = np.asarray(ends, np.int64)
+        if len(ends_a):
+            deg = np.diff(ends_a, prepend=0)
+            if deg.max() > 0xFFFF:     # pragma: no cover - a state with 65536 successors
+                raise OverflowError("more than 65535 successors of one state")
+            self.degree.append(deg.astype(np.uint16))
+        if not len(inv):
+            return np.zeros(0, np.int64)
+        self.rule.append(np.asarray(rules, self.rule.data.dtype))
+        ids, new = self._insert_distinct(distinct)
         # the parent of a new state is the source of the first edge reaching it; successors are
         # numbered in first-seen order, so a first occurrence is where the running maximum grows
         top = np.maximum.accumulate(inv)
@@ -288,7 +295,7 @@ class StateStore:
         pos = first[new]
         self.parent.append((lo + np.searchsorted(ends_a, pos, side="right")).astype(np.int32))
         self.dst.append(ids[inv].astype(np.int32))
-        return [distinct[i] for i in new.tolist()]
+        return new
 
     def add_states(self, states: list[int]) -> list[int]:
         """As a bare visited set (the parallel search's workers): insert `states` and return the
@@ -298,6 +305,18 @@ class StateStore:
             return []
         _, new = self._insert_distinct(self.to_words(distinct))
         return [distinct[i] for i in new.tolist()]
+
+    def add_rows(self, rows: np.ndarray) -> np.ndarray:
+        """`add_states` for uint64 word rows: the new ones (in sorted order, not first-seen)."""
+        if not len(rows):
+            return rows
+        # distinct rows: sorted by their words (lexsort is a few times faster than unique(axis=0))
+        reps = rows[np.lexsort(rows.T[::-1])]
+        keep = np.ones(len(reps), bool)
+        keep[1:] = (reps[1:] != reps[:-1]).any(axis=1)
+        reps = reps[keep]
+        _, new = self._insert_distinct(reps)
+        return reps[new]
 
     def _insert_distinct(self, reps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """For distinct rows `reps`: the id of each (stored or newly given) and which are new."""
@@ -354,31 +373,43 @@ class StateStore:
     # -- vectorised predicates -----------------------------------------------------------------
     def field(self, shift: int, width: int, lo: int, hi: int) -> np.ndarray:
         """The values of one bit field of states lo .. hi-1, as int64."""
-        word, off = divmod(shift, 64)
-        keys = self._unpack(self.keys.view[lo:hi])
-        v = keys[:, word] >> np.uint64(off)
-        if off + width > 64:
-            v = v | (keys[:, word + 1] << np.uint64(64 - off))
-        return (v & np.uint64((1 << width) - 1)).astype(np.int64)
+        return _bits(self._unpack(self.keys.view[lo:hi]), shift, width)
 
     def mask(self, layout, defs: list[tuple[str, str]], text: str, chunk: int = 1 << 18) -> np.ndarray:
         """Boolean array: does the expression `text` hold in each stored state?"""
-        node = expr.parse(text)
-        define = {name: expr.parse(t) for name, t in defs}
         out = np.empty(len(self), bool)
+        for lo, hi, (val,) in self.evaluate(layout, defs, [text], chunk):
+            out[lo:hi] = _truth(val) if np.ndim(val) else bool(val)
+        return out
+
+    def evaluate(self, layout, defs: list[tuple[str, str]], texts: list[str], chunk: int = 1 << 18):
+        """(lo, hi, [value of each expression in states lo .. hi-1]) a chunk of states at a time;
+        a value is an array, or a plain number where the expression is constant."""
+        nodes = [expr.parse(t) for t in texts]
+        define = {name: expr.parse(t) for name, t in defs}
         for lo in range(0, len(self), chunk):
             hi = min(lo + chunk, len(self))
             cache: dict[str, np.ndarray] = {}
+            words = self._unpack(self.keys.view[lo:hi])
 
-            def name(n: str, lo=lo, hi=hi, cache=cache) -> np.ndarray:
+            def name(n: str) -> np.ndarray:
                 if n not in cache:
                     cache[n] = (_eval(define[n], name) if n in define
-                                else self.field(layout.shift[n], layout.width[n], lo, hi))
+                                else _bits(words, layout.shift[n], layout.width[n]))
                 return cache[n]
-            val = _eval(node, name)
-            out[lo:hi] = _truth(val) if np.ndim(val) else bool(val)
-            cache.clear()          # `name` refers to itself: free the fields now, not at the next gc
-        return out
+            yield lo, hi, [_eval(node, name) for node in nodes]
+            # `name` refers to itself (a cycle the gc frees late): free what it holds now
+            cache.clear()
+            words = None
+
+
+def _bits(words: np.ndarray, shift: int, width: int) -> np.ndarray:
+    """One bit field of uint64 word rows, as int64."""
+    word, off = divmod(shift, 64)
+    v = words[:, word] >> np.uint64(off)
+    if off + width > 64:
+        v = v | (words[:, word + 1] << np.uint64(64 - off))
+    return (v & np.uint64((1 << width) - 1)).astype(np.int64)
 
 
 def _truth(v):

@@ -30,12 +30,15 @@ Abstracted away, and checked on bus traces by tracecheck instead:
 """
 from __future__ import annotations
 
+import numpy as np
+
 from model_check.expr import all_of, any_of, count_of
 from model_check.gcl import Event, Invariant, Model, Rule, SymGroup, Var
 from model_check.spec_adapter import PostNode, PostParams
 
 UNTESTED, OK, MISSING = 0, 1, 2
 VERDICT = {"OPERATIONAL": 1, "DEGRADED": 2, "HALTED": 3}
+NAMES = {code: name for name, code in VERDICT.items()}
 OUTCOMES = ("absent", "mute", "out_of_order")
 
 
@@ -160,6 +163,9 @@ def build(p: PostParams, legs: int | None = None, symmetry: bool = True) -> Mode
                   invariants=invs, final="vd != 0", symmetry=sym, participants=[root] + everything[:0],
                   notes=["seed 6.3 POST; each identification abstracted to its outcome (see id_retry)"])
     model.final_checks.append(("verdict_matches_oracle", lambda v: oracle_mismatch(p, t, names, v)))
+    # the oracle sees the self test, the verdict and who answered, on every final state at once
+    model.final_view = [("mcp", "mcp"), ("vd", "vd")] + [(x[s], f"{x[s]} == {OK}") for s in everything]
+    model.final_screen = lambda view: oracle_screen(p, t, names, view)
     return model
 
 
@@ -167,48 +173,80 @@ def expected_verdict(p: PostParams, t: Tree, answered: dict[str, bool], mcp_ok: 
     """seed 6.3, by the spec's rule: the verdict and the required nodes it must name, from which nodes
     answered their identification (`answered`, short -> bool, every node of the tree) and the hierarchy.
 
-    The independent oracle of this model, and the rule the trace validator holds the MCP's verdict to."""
-    def present(s: str) -> bool:
-        n = t.by[s]
-        up = mcp_ok if n.master == p.root else present(n.master)
-        return up and answered[s]
+    The independent oracle of this model, and the rule the trace validator holds the MCP's verdict to
+    (one case of `expected_verdicts`)."""
+    codes, named = expected_verdicts(p, t, {s: np.array([a], bool) for s, a in answered.items()},
+                                     np.array([mcp_ok], bool))
+    return NAMES[int(codes[0])], {s for s, m in named.items() if m[0]}
 
-    absent = [s for s in answered if not present(s)]
-    if not mcp_ok:
-        return "HALTED", {p.root}
-    named = {s for s in absent if t.by[s].required}
-    expect = "OPERATIONAL"
+
+def expected_verdicts(p: PostParams, t: Tree, answered: dict[str, np.ndarray],
+                      mcp_ok: np.ndarray) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """`expected_verdict` for many cases at once (one bool array per node, aligned): the verdicts
+    (VERDICT codes) and, per node, in which cases the verdict must name it. The model checker
+    runs it on every final state in bulk (issue 12); the trace validator on one case."""
+    known: dict[str, np.ndarray] = {}
+
+    def present(s: str) -> np.ndarray:
+        if s not in known:
+            n = t.by[s]
+            known[s] = (mcp_ok if n.master == p.root else present(n.master)) & answered[s]
+        return known[s]
+
+    absent = {s: ~present(s) for s in answered}
+    named = {s: a for s, a in absent.items() if t.by[s].required}
+    halted = np.zeros_like(mcp_ok)
+    degraded = np.zeros_like(mcp_ok)
     for name, key, least, roles in p.quorums:
         groups: dict[int, list[str]] = {}
         for s in answered:
             if p.roles[s] in roles and getattr(t.by[s], key) is not None:
                 groups.setdefault(getattr(t.by[s], key), []).append(s)
-        whole = sum(all(present(s) for s in g) for g in groups.values())
-        outside = named - {s for g in groups.values() for s in g}
-        if whole < least or outside:
-            expect = "HALTED"
-        elif whole < len(groups) and expect != "HALTED":
-            expect = "DEGRADED"
-        if not (whole < least):
-            named -= {s for g in groups.values() for s in g}   # a tolerated missing leg is no reason to halt
-    if expect != "HALTED" and any(not t.by[s].required for s in absent):
-        expect = "DEGRADED"
-    if not p.quorums and named:
-        expect = "HALTED"
-    return expect, named
+        members = {s for g in groups.values() for s in g}
+        whole = sum(np.logical_and.reduce([present(s) for s in g]).astype(np.int64) for g in groups.values())
+        low = np.asarray(whole < least)
+        outside = np.logical_or.reduce([m for s, m in named.items() if s not in members] + [np.zeros_like(low)])
+        halted = halted | low | outside
+        degraded = degraded | (whole < len(groups))
+        for s in members & named.keys():
+            named[s] = named[s] & low            # a tolerated missing leg is no reason to halt
+    degraded = degraded | np.logical_or.reduce([a for s, a in absent.items() if not t.by[s].required]
+                                               + [np.zeros_like(mcp_ok)])
+    if not p.quorums:
+        halted = halted | np.logical_or.reduce(list(named.values()) + [np.zeros_like(mcp_ok)])
+    # a failed self test halts and names the MCP alone
+    halted = halted | ~mcp_ok
+    named = {s: m & mcp_ok for s, m in named.items()}
+    named[p.root] = named.get(p.root, np.zeros_like(mcp_ok)) | ~mcp_ok
+    codes = np.where(halted, VERDICT["HALTED"], np.where(degraded, VERDICT["DEGRADED"], VERDICT["OPERATIONAL"]))
+    return codes, named
+
+
+def oracle_screen(p: PostParams, t: Tree, names: dict[str, str], view: dict[str, np.ndarray]) -> np.ndarray:
+    """`oracle_mismatch` on many final views at once: True where it reports a problem."""
+    mcp_ok = view["mcp"] != 2
+    answered = {names[k]: v != 0 for k, v in view.items() if k in names}
+    codes, named = expected_verdicts(p, t, answered, mcp_ok)
+    halted = (codes == VERDICT["HALTED"]) & (view["vd"] == VERDICT["HALTED"])
+    # a HALTED report names the required nodes that did not answer: one named but answered is missing
+    unreported = np.logical_or.reduce([named[s] & answered[s] for s in answered if s in named]
+                                      + [np.zeros_like(mcp_ok)])
+    return np.where(halted, mcp_ok & unreported, codes != view["vd"])
 
 
 def oracle_mismatch(p: PostParams, t: Tree, names: dict[str, str], values: dict[str, int]) -> str | None:
-    """Independent oracle: verdict and missing required nodes straight from conditions and the hierarchy."""
-    cond = {names[k]: v for k, v in values.items() if k in names}
-    expect, named = expected_verdict(p, t, {s: c == OK for s, c in cond.items()}, values["mcp"] != 2)
-    got = {v: k for k, v in VERDICT.items()}[values["vd"]]
-    reported = {p.root} if values["mcp"] == 2 else {s for s in cond if t.by[s].required and cond[s] != OK}
+    """Independent oracle: verdict and missing required nodes straight from conditions and the hierarchy.
+
+    `values` is the model's final view: mcp, vd and, per node variable, 1 if the node answered."""
+    answered = {names[k]: bool(v) for k, v in values.items() if k in names}
+    expect, named = expected_verdict(p, t, answered, values["mcp"] != 2)
+    got = NAMES[values["vd"]]
+    reported = {p.root} if values["mcp"] == 2 else {s for s in answered if t.by[s].required and not answered[s]}
     if expect == "HALTED" and got == "HALTED":
         if values["mcp"] != 2 and not (named <= reported):
             return f"HALTED report {sorted(reported)} does not name {sorted(named - reported)}"
         return None
     if got != expect:
-        absent = sorted(s for s in cond if cond[s] != OK)
+        absent = sorted(s for s in answered if not answered[s])
         return f"verdict {got}, oracle says {expect} (missing: {absent})"
     return None

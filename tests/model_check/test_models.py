@@ -110,6 +110,7 @@ def test_post_oracle_catches_a_wrong_quorum(spec):
     tree = post.Tree(p, None)
     names = {tree.var[s]: s for s in tree.var}
     model.final_checks = [("oracle", lambda v: post.oracle_mismatch(p, tree, names, v))]
+    model.final_screen = lambda view: post.oracle_screen(p, tree, names, view)
     # only the legs vary (every other node answers), to keep the run short
     model.rules = [r for r in model.rules if not r.name.startswith("id_") or r.name.endswith("_present")
                    or r.name.startswith(("id_LCP", "id_JAC"))]

@@ -1,0 +1,337 @@
+"""The successor function in C (issue 12: >= 500k states/s on one core), built like SPIN's pan.c.
+
+The same model text that `fastgen` turns into Python is turned into one C
+function per model, compiled once with the system C compiler into a shared
+library cached by the hash of its source, and called through ctypes on a slice
+of the frontier at a time. Its contract is the Python `edges` function's, plus
+the in-layer deduplication `StateStore.add_layer` did with dicts:
+
+- states are rows of W uint64 words (the packed int of compile.Layout, little
+  end first); a frontier slice comes in as an (n, W) array;
+- each state: invariants in order (the first that fails is the hit), then the
+  rules in order; every successor is canonicalised (symmetry) and recorded as
+  an edge: its rule, and the number of its successor among the distinct ones
+  of this call, in first-seen order (a local open-addressing hash table);
+  after the state, the number of edges so far (`ends`);
+- no rule enabled and not `final`: a deadlock hit; an effect outside its
+  variable's range: a RangeError hit naming rule, variable and value (raised
+  in Python, with the message fastgen's code gives);
+- it stops before a state whose successors might not fit the buffers and
+  reports how many states it finished, so the caller calls again.
+
+So ids, parents, edges, coverage, depth, verdicts and counterexamples are
+those of the Python path (tests/model_check/test_native.py compares them).
+Where there is no C compiler, or a model uses something this generator does not
+translate (a divisor that is not a non-zero constant, a field wider than 64 bits),
+`build` returns None and the engine keeps the Python path.
+"""
+from __future__ import annotations
+
+import ast
+import ctypes
+import hashlib
+import os
+import shutil
+import subprocess
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from model_check import expr
+from model_check.gcl import Model
+
+CC_FLAGS = ("-O1", "-shared", "-fPIC", "-std=c99", "-w")
+HIT_NONE, HIT_INVARIANT, HIT_DEADLOCK, HIT_RANGE, HIT_FULL = 0, 1, 2, 3, 4
+MAX_EDGES = 1 << 16       # edges per call at most: bounds the buffers (about 3 MB for 3-word states)
+
+
+class Unsupported(Exception):
+    """A construct this generator does not translate: the model stays on the Python path."""
+
+
+def _cache_dir() -> Path:
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "arachnae" / "model_check"
+
+
+# -- expressions ------------------------------------------------------------------------
+
+_C_CMP = {ast.Eq: "==", ast.NotEq: "!=", ast.Lt: "<", ast.LtE: "<=", ast.Gt: ">", ast.GtE: ">="}
+_C_BIN = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*"}
+INT64 = (-(1 << 63), (1 << 63) - 1)
+
+
+def _c(node: ast.expr, name) -> str:
+    """C text of an expression of the shared language (model_check.expr); `name(id)` maps a name."""
+    def e(n: ast.expr) -> str:
+        return _c(n, name)
+
+    if isinstance(node, ast.Name):
+        return name(node.id)
+    if isinstance(node, ast.Constant):
+        v = int(node.value)
+        if not INT64[0] < v <= INT64[1]:
+            raise Unsupported(f"constant {v}")
+        return f"((int64_t){v}LL)"
+    if isinstance(node, ast.BoolOp):
+        op = " && " if isinstance(node.op, ast.And) else " || "
+        return "(" + op.join(e(v) for v in node.values) + ")"
+    if isinstance(node, ast.UnaryOp):
+        return f"(!{e(node.operand)})" if isinstance(node.op, ast.Not) else f"(-{e(node.operand)})"
+    if isinstance(node, ast.BinOp):
+        op = type(node.op)
+        if op in _C_BIN:
+            return f"({e(node.left)} {_C_BIN[op]} {e(node.right)})"
+        # Python's floor division and modulo; only by a non-zero constant (no ZeroDivisionError to mimic)
+        if not (isinstance(node.right, ast.Constant) and int(node.right.value) != 0):
+            raise Unsupported("division by a non-constant")
+        return f"{'pdiv' if op is ast.FloorDiv else 'pmod'}({e(node.left)}, {e(node.right)})"
+    if isinstance(node, ast.Compare):
+        return f"({e(node.left)} {_C_CMP[type(node.ops[0])]} {e(node.comparators[0])})"
+    if isinstance(node, ast.IfExp):
+        return f"({e(node.test)} ? {e(node.body)} : {e(node.orelse)})"
+    if isinstance(node, ast.Call):
+        a, b = (e(x) for x in node.args)
+        return f"{'imin' if node.func.id == 'min' else 'imax'}({a}, {b})"   # type: ignore[attr-defined]
+    raise Unsupported(ast.dump(node)[:40])
+
+
+_PRELUDE = """\
+#include <stdint.h>
+#include <string.h>
+typedef int64_t I;
+typedef uint64_t U;
+static inline U getb(const U *s, unsigned sh, unsigned w) {
+    unsigned k = sh >> 6, o = sh & 63;
+    U m = w >= 64 ? ~(U)0 : (((U)1 << w) - 1);
+    if (o + w <= 64) return (s[k] >> o) & m;
+    return ((s[k] >> o) | (s[k + 1] << (64 - o))) & m;
+}
+static inline void setb(U *s, unsigned sh, unsigned w, U v) {
+    unsigned k = sh >> 6, o = sh & 63;
+    U m = w >= 64 ? ~(U)0 : (((U)1 << w) - 1);
+    s[k] = (s[k] & ~(m << o)) | ((v & m) << o);
+    if (o + w > 64) s[k + 1] = (s[k + 1] & ~(m >> (64 - o))) | ((v & m) >> (64 - o));
+}
+static inline I imin(I a, I b) { return a < b ? a : b; }
+static inline I imax(I a, I b) { return a > b ? a : b; }
+static inline I pdiv(I a, I b) { I q = a / b; return (a % b != 0 && ((a < 0) != (b < 0))) ? q - 1 : q; }
+static inline I pmod(I a, I b) { I r = a % b; return (r != 0 && ((r < 0) != (b < 0))) ? r + b : r; }
+"""
+
+
+class _Src:
+    """The C text of one model, from its variables' bit fields (compile.Layout)."""
+
+    def __init__(self, model: Model, shift: dict[str, int], width: dict[str, int], total_bits: int):
+        self.model, self.shift, self.width = model, shift, width
+        self.words = max(1, -(-total_bits // 64))
+
+    def var(self, n: str, src: str = "s") -> str:
+        return f"((I)getb({src}, {self.shift[n]}u, {self.width[n]}u))"
+
+    def name(self, n: str) -> str:
+        return self.var(n) if n in self.shift else f"d_{n}(s)"
+
+    def source(self) -> str:
+        m, W = self.model, self.words
+        out = [_PRELUDE, f"#define W {W}"]
+        for n, text in m.defs:                  # definitions: pure functions of the state
+            out.append(f"static inline I d_{n}(const U *s) {{ return {_c(expr.parse(text), self.name)}; }}")
+        out += self.canon()
+        out.append("static inline int inv_fail(const U *s) {")
+        for i, inv in enumerate(m.invariants):
+            out.append(f"    if (!({_c(expr.parse(inv.expr), self.name)})) return {i};")
+        out.append("    return -1;\n}")
+        out.append(f"static inline int is_final(const U *s) {{ return ({_c(expr.parse(m.final), self.name)}) != 0; }}")
+        out += self.search()
+        return "\n".join(out) + "\n"
+
+    def canon(self) -> list[str]:
+        """Sort each symmetry group's blocks ascending, in the group order (compile._canon_source)."""
+        out = ["static inline void canon(U *t) {"]
+        for g in self.model.symmetry:
+            starts = [self.shift[b[0]] for b in g.blocks]
+            width = sum(self.width[n] for n in g.blocks[0])
+            if width > 64:
+                raise Unsupported("symmetry block wider than 64 bits")
+            k = len(starts)
+            out.append("    {")
+            out.append(f"        U w[{k}];")
+            out += [f"        w[{i}] = getb(t, {st}u, {width}u);" for i, st in enumerate(starts)]
+            out.append(f"        for (int i = 1; i < {k}; i++) {{ U x = w[i]; int j = i - 1;"
+                       " while (j >= 0 && w[j] > x) { w[j + 1] = w[j]; j--; } w[j + 1] = x; }")
+            out += [f"        setb(t, {st}u, {width}u, w[{i}]);" for i, st in enumerate(starts)]
+            out.append("    }")
+        out.append("}")
+        return out
+
+    def rule(self, ri: int) -> list[str]:
+        """One rule: guard, effects in order (each reading the values assigned before it), range
+        checks, the packed and canonical successor, and its edge."""
+        m = self.model
+        rule = m.rules[ri]
+        out = [f"        if ({_c(expr.parse(rule.guard), self.name)}) {{", "            en = 1;"]
+        current: dict[str, str] = {}
+        for k, (target, value) in enumerate(rule.effect):
+            hi = m.var(target).hi
+            local = f"n{k}"
+            out.append(f"            I {local} = "
+                       f"{_c(expr.parse(value), lambda n: current.get(n) or self.name(n))};")
+            out.append(f"            if ({local} < 0 || {local} > {hi}LL) "
+                       f"{{ r->rule = {ri}; r->var = {m.vars.index(m.var(target))}; r->value = {local}; "
+                       f"r->kind = {HIT_RANGE}; goto stop; }}")
+            current[target] = local
+        out.append("            memcpy(t, s, sizeof t);")
+        for target, local in current.items():
+            out.append(f"            setb(t, {self.shift[target]}u, {self.width[target]}u, (U){local});")
+        if m.symmetry:
+            out.append("            canon(t);")
+        out.append(f"            EDGE({ri});")
+        out.append("        }")
+        return out
+
+    def search(self) -> list[str]:
+        n_rules = len(self.model.rules)
+        out = ["""\
+typedef struct { int64_t done, edges, distinct, kind, index, rule, var, value; } Res;
+#define EDGE(RI) do { \\
+    U hh = 0x9E3779B97F4A7C15ULL; \\
+    for (int q = 0; q < W; q++) { hh ^= t[q]; hh *= 0xBF58476D1CE4E5B9ULL; hh ^= hh >> 31; } \\
+    U slot = hh & tmask; \\
+    int32_t got; \\
+    for (U step = 1;; step++) { \\
+        got = table[slot]; \\
+        if (got < 0) { got = (int32_t)nd; table[slot] = got; memcpy(out + (size_t)nd * W, t, sizeof t); nd++; break; } \\
+        if (memcmp(out + (size_t)got * W, t, sizeof t) == 0) break; \\
+        slot = (slot + step) & tmask; \\
+    } \\
+    inv[ne] = got; rules[ne] = (RI); ne++; \\
+} while (0)
+""",
+               "void expand(const U *front, int64_t n, U *out, int32_t *inv, int32_t *rules, int64_t *ends,",
+               "            int64_t cap, int32_t *table, int64_t tsize, Res *r) {",
+               "    U tmask = (U)tsize - 1; int64_t ne = 0, nd = 0, i = 0; U t[W];",
+               "    r->kind = 0;",
+               "    for (; i < n; i++) {",
+               f"        if (ne + {max(n_rules, 1)} > cap) {{ r->kind = {HIT_FULL}; break; }}",
+               "        const U *s = front + (size_t)i * W;",
+               "        int bad = inv_fail(s);",
+               f"        if (bad >= 0) {{ r->kind = {HIT_INVARIANT}; r->index = bad; break; }}",
+               "        int en = 0;"]
+        for ri in range(n_rules):
+            out += self.rule(ri)
+        out += [f"        if (!en && !is_final(s)) {{ r->kind = {HIT_DEADLOCK}; break; }}",
+                "        ends[i] = ne;",
+                "    }",
+                "stop:",
+                "    r->done = i; r->edges = ne; r->distinct = nd;",
+                "}"]
+        return out
+
+
+class _Res(ctypes.Structure):
+    _fields_ = [(f, ctypes.c_int64) for f in ("done", "edges", "distinct", "kind", "index", "rule", "var", "value")]
+
+
+@dataclass
+class Chunk:
+    """What one call of the C function produced for the first `done` states of its slice."""
+
+    done: int                    # states fully expanded (their edges are below)
+    distinct: np.ndarray         # (d, W) uint64: the distinct successors, first-seen order
+    inv: np.ndarray              # per edge: index into `distinct`
+    rules: np.ndarray            # per edge: the rule
+    ends: np.ndarray             # per state: edges so far after it
+    kind: int                    # HIT_* (HIT_FULL: buffers full, call again from `done`)
+    index: int                   # invariant index (HIT_INVARIANT)
+    rule: int = -1               # HIT_RANGE: the rule, variable index and value
+    var: int = -1
+    value: int = 0
+
+    def hit(self, state: int | None = None) -> tuple | None:
+        """The violation as the Python `edges` reports it: (kind, index, state), or None."""
+        if self.kind == HIT_INVARIANT:
+            return ("invariant", self.index, state)
+        return ("deadlock", -1, state) if self.kind == HIT_DEADLOCK else None
+
+    def range_message(self, model: Model) -> str:
+        """HIT_RANGE: the RangeError's text, as the Python `edges` words it."""
+        return f"{model.rules[self.rule].name}: {model.vars[self.var].name} = {self.value}"
+
+
+class Native:
+    """A compiled model: `expand(rows)` runs the C function over a slice of frontier rows."""
+
+    def __init__(self, lib: ctypes.CDLL, words: int, rules: int):
+        self.words, self.n_rules = words, max(rules, 1)
+        self.fn = lib.expand
+        self.fn.restype = None
+        self.cap = 0
+        self.res = _Res()
+
+    def _buffers(self, states: int) -> None:
+        """Sized for `states` states at most (a small model's search stays small: issue 12's
+        100 bytes/state), up to MAX_EDGES edges per call; grown, never shrunk."""
+        want = max(self.n_rules, min(MAX_EDGES, states * self.n_rules))   # >= one state's edges
+        if want > self.cap:
+            self.cap = want
+            self.tsize = 1 << (2 * want - 1).bit_length()      # load <= 0.5
+            self.out = np.empty((want, self.words), np.uint64)
+            self.inv = np.empty(want, np.int32)
+            self.rules = np.empty(want, np.int32)
+            self.table = np.empty(self.tsize, np.int32)
+
+    def expand(self, rows: np.ndarray) -> Chunk:
+        """Expand the frontier rows in order until done, a hit, or full buffers (`Chunk.done`)."""
+        self._buffers(len(rows))
+        rows = np.ascontiguousarray(rows, np.uint64)
+        ends = np.empty(len(rows), np.int64)
+        self.table.fill(-1)
+        p = ctypes.c_void_p
+        self.fn(p(rows.ctypes.data), ctypes.c_int64(len(rows)), p(self.out.ctypes.data), p(self.inv.ctypes.data),
+                p(self.rules.ctypes.data), p(ends.ctypes.data), ctypes.c_int64(self.cap),
+                p(self.table.ctypes.data), ctypes.c_int64(self.tsize), ctypes.byref(self.res))
+        r = self.res
+        return Chunk(int(r.done), self.out[:r.distinct].copy(), self.inv[:r.edges].copy(),
+                     self.rules[:r.edges].copy(), ends[:r.done], int(r.kind), int(r.index),
+                     int(r.rule), int(r.var), int(r.value))
+
+
+def c_source(model: Model, shift: dict[str, int], width: dict[str, int], total_bits: int) -> str:
+    """The C source of `model`'s successor function (raises Unsupported)."""
+    if any(w > 64 for w in width.values()):
+        raise Unsupported("a field wider than 64 bits")
+    return _Src(model, shift, width, total_bits).source()
+
+
+def build(model: Model, shift: dict[str, int], width: dict[str, int], total_bits: int) -> Native | None:
+    """The compiled successor function, or None (no compiler, an untranslated construct, or
+    ARACHNAE_NATIVE=0 in the environment): the caller then uses the Python one."""
+    if os.environ.get("ARACHNAE_NATIVE", "1") == "0":
+        return None
+    cc = shutil.which(os.environ.get("CC", "cc"))
+    if cc is None:
+        return None
+    try:
+        src = c_source(model, shift, width, total_bits)
+    except Unsupported:
+        return None
+    digest = hashlib.sha256((src + " ".join(CC_FLAGS)).encode()).hexdigest()[:24]
+    cache = _cache_dir()
+    lib = cache / f"succ_{digest}.so"
+    if not lib.exists():
+        try:
+            cache.mkdir(parents=True, exist_ok=True)
+            with tempfile.TemporaryDirectory(dir=cache) as tmp:
+                c_file, so = Path(tmp) / "succ.c", Path(tmp) / "succ.so"
+                c_file.write_text(src)
+                subprocess.run([cc, *CC_FLAGS, "-o", str(so), str(c_file)], check=True,
+                               capture_output=True, timeout=300)
+                os.replace(so, lib)             # atomic: a concurrent run sees all of it or nothing
+        except (OSError, subprocess.SubprocessError):
+            return None
+    words = max(1, -(-total_bits // 64))
+    return Native(ctypes.CDLL(str(lib)), words, len(model.rules))
