@@ -152,22 +152,12 @@ def without(doc: Any, path: tuple) -> Any:
     return out
 
 
-# A node's own debug figures (metrics.json `nodes.<NODE>.*`) have no declared shape, so an expectation on
-# them cannot be type-checked before the run; a wrong operand there fails the run's expectation at its end.
-# This is the one place the audit does not demand a load-time refusal (docs/security.md says so).
-_FREE_FORM = ("expect", "metrics")
-
-
-def _free_form(path: tuple) -> bool:
-    return path[:2] == _FREE_FORM and len(path) > 2 and str(path[2]).startswith("nodes.")
-
-
 def doc_mutants(doc: Any) -> Iterator[tuple[str, Any, bool]]:
     """(label, mutated document, certainly bad) for every node and every mutation of it."""
     for path, value in leaves(doc):
         where = ".".join(str(p) for p in path)
         for m in mutations(value):
-            yield f"{where}: {m.label}", with_value(doc, path, m.value), m.bad and not _free_form(path)
+            yield f"{where}: {m.label}", with_value(doc, path, m.value), m.bad
         if isinstance(path[-1], str):
             yield f"{where}: removed", without(doc, path), False
 
