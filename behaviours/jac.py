@@ -14,6 +14,7 @@ limp instead of standing stiff in the other legs' way (CHOICE).
 from __future__ import annotations
 
 import math
+from typing import TypedDict
 
 from arachnae_proto import messages as M
 from arachnae_proto.enums import JointFlags
@@ -39,6 +40,12 @@ def drive_command(target: float, angle: float, limit: float) -> float:
     if abs(err) < T.JAC_DEADBAND_RAD:
         return 0.0
     return max(-limit, min(limit, T.JAC_KP * err))
+
+
+class JacDebug(TypedDict):
+    """JAC.debug_metrics(): metrics.json `nodes.<JAC>` (sim2d.metrics checks expectations on it at load)."""
+    temperature_c: float
+    flags: int
 
 
 class JAC(Runtime, JacSkeleton):
@@ -103,7 +110,7 @@ class JAC(Runtime, JacSkeleton):
                                        current=_FB_MA.raw(s.current * 1000), temperature=_FB_TEMP.raw(s.temperature),
                                        flags=self.flags()))
 
-    def debug_metrics(self) -> dict:
+    def debug_metrics(self) -> JacDebug:
         """Debug port: the servo's winding temperature and flags at the end of a run."""
         s = self.hw.servo_state()
         return {"temperature_c": round(s.temperature, 1), "flags": self.flags()}

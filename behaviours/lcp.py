@@ -30,6 +30,7 @@ when the sole touches ground again.
 from __future__ import annotations
 
 import math
+from typing import TypedDict
 
 from arachnae_proto import messages as M
 from arachnae_proto.enums import JointFlags, LegFlags, LegPhase, OrderStatus
@@ -81,6 +82,15 @@ class Segment:
 
     def done(self, t: float) -> bool:
         return t >= self.t0 + self.dur
+
+
+class LcpDebug(TypedDict):
+    """LCP.debug_metrics(): metrics.json `nodes.<LCP>` (sim2d.metrics checks expectations on it at load)."""
+    flags: int
+    blocked_events: int
+    stall_holds: int
+    failed: bool
+    dead_jacs: int
 
 
 class LCP(PostMaster, Runtime, LcpSkeleton):
@@ -318,7 +328,7 @@ class LCP(PostMaster, Runtime, LcpSkeleton):
         bad = self.failed or bool(self.dead_jacs)
         return M.StatusAckOrder(status=int(OrderStatus.OUT_OF_ORDER if bad else OrderStatus.IN_ORDER))
 
-    def debug_metrics(self) -> dict:
+    def debug_metrics(self) -> LcpDebug:
         """Debug port: the leg's flags and reflex counts at the end of a run."""
         return {"flags": self.flags, "blocked_events": self.blocked_events, "stall_holds": self.stall_holds,
                 "failed": self.failed,

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import csv
 from pathlib import Path
+from typing import TypedDict
 
 from arachnae_proto import messages as M
 from arachnae_proto.enums import BusyStatus, MovCmd, RecordKind
@@ -33,6 +34,12 @@ from behaviours.rcp_screen import Screen
 
 _MCP, _NP3 = ADDRESS_OF["MCP"], ADDRESS_OF["NP3"]
 _REDRAW = "\x0c"          # Ctrl-L: the terminal asks for the whole picture again
+
+
+class SscDebug(TypedDict):
+    """SSC.debug_metrics(): metrics.json `nodes.SSC` (sim2d.metrics checks expectations on it at load)."""
+    utterances: int
+    texts: list[str]
 
 
 class SSC(Runtime, SscSkeleton):
@@ -58,7 +65,7 @@ class SSC(Runtime, SscSkeleton):
         return M.StatusAckBusy(status=int(self.speaker.busy))
 
     # -- debug port: the run log ------------------------------------------------------------
-    def debug_metrics(self) -> dict:
+    def debug_metrics(self) -> SscDebug:
         said = self.speaker.said()
         return {"utterances": len(said), "texts": sorted({text for _t, text in said})}
 
@@ -111,6 +118,13 @@ class _Records:
         """Hook: a record left for the MCP."""
 
 
+class ApuSdfDebug(TypedDict):
+    """APU_SDF.debug_metrics(): metrics.json `nodes.APU/SDF`."""
+    events_heard: int
+    events_too_quiet: int
+    records_sent: int
+
+
 class APU_SDF(_Records, Runtime, ApuSdfSkeleton):
     """seed 3.2.7, 4.3: detect a sound event and the direction it came from; report it to the NP3."""
 
@@ -149,8 +163,17 @@ class APU_SDF(_Records, Runtime, ApuSdfSkeleton):
         busy = self.processing is not None or bool(self.outbox)
         return M.StatusAckBusy(status=int(BusyStatus.BUSY if busy else BusyStatus.NOT_BUSY))
 
-    def debug_metrics(self) -> dict:
+    def debug_metrics(self) -> ApuSdfDebug:
         return {"events_heard": self.heard, "events_too_quiet": self.ignored, "records_sent": self.records_sent}
+
+
+class UicRcpDebug(TypedDict):
+    """UIC_RCP.debug_metrics(): metrics.json `nodes.UIC/RCP`."""
+    keys: int
+    records_sent: int
+    alerts: int
+    commands: dict[str, int]        # command label -> times sent
+    lcd: list[str]
 
 
 class UIC_RCP(_Records, Runtime, UicRcpSkeleton):
@@ -200,7 +223,7 @@ class UIC_RCP(_Records, Runtime, UicRcpSkeleton):
         """seed 3.2.8: BUSY while an operator command waits for the bus (CHOICE)."""
         return M.StatusAckBusy(status=int(BusyStatus.BUSY if self.outbox else BusyStatus.NOT_BUSY))
 
-    def debug_metrics(self) -> dict:
+    def debug_metrics(self) -> UicRcpDebug:
         return {"keys": self.keys, "records_sent": self.records_sent, "alerts": self.alerts,
                 "commands": dict(sorted(self.commands.items())), "lcd": [line.rstrip() for line in self.screen.lcd]}
 

@@ -9,6 +9,8 @@ under-voltage it starts the UIC's beeper and blinks its own LED.
 """
 from __future__ import annotations
 
+from typing import TypedDict
+
 from arachnae_proto import messages as M
 from arachnae_proto.enums import Alert, Gait, MmcError, MovCmd, RangeStatus, RecordKind, SscMessage
 from arachnae_proto.network import ADDRESS_OF, BROADCAST, NODES
@@ -50,6 +52,25 @@ def names_line(prefix: str, names: tuple[str, ...]) -> str:
     """'MISSING MMC,SPU' cut to the LCD width with a '+' when not all names fit."""
     text = prefix + ",".join(top_missing(names))
     return text if len(text) <= _LCD_WIDTH else text[:_LCD_WIDTH - 1] + "+"
+
+
+class McpDebug(TypedDict):
+    """MCP.debug_metrics(): metrics.json `nodes.MCP` (sim2d.metrics checks expectations on it at load)."""
+    verdict: str | None
+    missing: str
+    faults: dict[str, int]          # node -> last non-zero status relayed
+    posts: int
+    halted: bool
+    lcd_line0: str
+    lcd_line1: str
+    battery_low: bool
+    operator: int                   # the counts: messages to the operator and supervisor, records, ...
+    supervisor: int
+    records: int
+    alarms: int
+    status_records: int
+    mmc_status: int
+    led_blinks: int
 
 
 class MCP(PostMaster, Runtime, McpSkeleton):
@@ -256,7 +277,7 @@ class MCP(PostMaster, Runtime, McpSkeleton):
         self.hw.note("operator_message", text=" / ".join(lines), to=to, nodes=sent_to,
                      say=say.name if say is not None else None)
 
-    def debug_metrics(self) -> dict:
+    def debug_metrics(self) -> McpDebug:
         v = self.verdict
         faults = {NODES[a].short: value for (a, _ch), value in sorted(self.faults.items()) if a in NODES}
         return {"verdict": v.verdict if v else None, "missing": ",".join(top_missing(v.missing)) if v else "",

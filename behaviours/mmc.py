@@ -27,6 +27,8 @@ old news once reported).
 """
 from __future__ import annotations
 
+from typing import TypedDict
+
 from arachnae_proto import messages as M
 from arachnae_proto.enums import Direction, Gait as GaitCode, LegFlags, LegPhase, MmcError, MovCmd, OrderStatus
 from arachnae_proto.network import NODES
@@ -47,6 +49,25 @@ _NONE = int(MmcError.NONE)
 _URGENCY = [int(e) for e in (MmcError.NO_GROUND, MmcError.LCP_OUT_OF_ORDER, MmcError.JAC_OUT_OF_ORDER,
                              MmcError.LEG_DRIVE_FAILED, MmcError.LEG_DRIVE_BLOCKED)]
 _OUT_OF_ORDER = int(OrderStatus.OUT_OF_ORDER)
+
+
+class MmcDebug(TypedDict):
+    """MMC.debug_metrics(): metrics.json `nodes.MMC` (sim2d.metrics checks expectations on it at load)."""
+    error: str                      # MmcError name
+    error_leg: int
+    errors: dict[str, str]          # leg -> MmcError name
+    gait: str
+    direction: str
+    legs: int
+    lost_legs: list[int]
+    five_legged: bool
+    gait_switches: int
+    commands: dict[str, int]
+    gaits_used: list[str]
+    walked_s: dict[str, float]
+    pits: int
+    pause_s: float
+    overtemp_legs: list[int]
 
 
 class MMC(PostMaster, Runtime, MmcSkeleton):
@@ -224,7 +245,7 @@ class MMC(PostMaster, Runtime, MmcSkeleton):
         return M.StatusAckMmc(gait=int(GaitCode(self.gait.gait)), direction=int(Direction(self.gait.command)),
                               leg=leg, error=err)
 
-    def debug_metrics(self) -> dict:
+    def debug_metrics(self) -> MmcDebug:
         """Debug port: what the MMC did (scenario expectations read these)."""
         leg, err = self._worst()
         return {

@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 from collections import deque
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict
 
 from arachnae_proto import messages as M
 from arachnae_proto.enums import MmcError, MovCmd, RangeStatus, RecordKind, TpscContact
@@ -81,6 +81,34 @@ class DeadReckoning:
     @property
     def pose(self) -> tuple[float, float, float]:
         return self.x, self.y, self.th
+
+
+class Np3Map(TypedDict):
+    places: int
+    edges: int
+    routes: int
+    seen_m2: float
+
+
+class Np3Light(TypedDict, total=False):      # empty before the first light reading
+    first_lux: float
+    last_lux: float
+    ratio: float
+
+
+class Np3Debug(TypedDict, total=False):      # control, switches and moves_sent only, before navigation starts
+    """NP3.debug_metrics(): metrics.json `nodes.NP3` (sim2d.metrics checks expectations on it at load)."""
+    control: dict[str, float]       # layer -> seconds it held the MMC
+    switches: int
+    takeovers: dict[str, int]       # reflex -> times it took over
+    moves_sent: int
+    records: int
+    pose: list[float]
+    battery_low: bool
+    ir_fault: bool
+    sonar_ignored: bool
+    map: Np3Map
+    light: Np3Light
 
 
 class NP3(Runtime, Np3Skeleton):
@@ -411,7 +439,7 @@ class NP3(Runtime, Np3Skeleton):
         self.map.add(cone)
 
     # --- debug port --------------------------------------------------------------------------------
-    def debug_metrics(self) -> dict[str, Any]:
+    def debug_metrics(self) -> Np3Debug:
         """Which layer held the MMC and for how long (decision 8), reflex take-overs, map and light figures."""
         if "move" not in self.layers.traces:
             return {"control": {}, "switches": 0, "moves_sent": 0}

@@ -16,7 +16,7 @@ reliable value it reports.
 from __future__ import annotations
 
 from collections import deque
-from typing import Callable
+from typing import Callable, TypedDict
 
 from arachnae_proto import messages as M
 from arachnae_proto.enums import RangeStatus, TpscContact
@@ -81,6 +81,23 @@ class AlarmLimit:
         return False
 
 
+class SensorDebug(TypedDict):
+    """_Sensor.debug_metrics(): metrics.json `nodes.<sensor>` (sim2d.metrics checks expectations on it at load)."""
+    alarms: int
+
+
+class RangeSensorDebug(SensorDebug):
+    status: str                     # RangeStatus name
+    measurements: int
+    second_sets: int
+
+
+class PscDebug(SensorDebug):
+    mean_v: float | None
+    mean_min_v: float | None
+    level_min_v: float | None
+
+
 class _Sensor(Runtime):
     """What the sensor controllers share: the SPU as master, DATA_RDY announcements, SET_ALARM limits."""
 
@@ -113,7 +130,7 @@ class _Sensor(Runtime):
             self.announce()
         return fired
 
-    def debug_metrics(self) -> dict:
+    def debug_metrics(self) -> SensorDebug:
         return {"alarms": self.alarm_count}
 
 
@@ -160,7 +177,7 @@ class _RangeSensor(_Sensor):
     def on_free_run(self, src: int, msg: M.FreeRun) -> None:
         self.free_run = True
 
-    def debug_metrics(self) -> dict:
+    def debug_metrics(self) -> RangeSensorDebug:
         return {**super().debug_metrics(), "status": RangeStatus(self.status).name,
                 "measurements": self.measurements, "second_sets": self.second_sets}
 
@@ -438,7 +455,7 @@ class PSC(_Averaging, PscSkeleton):
         self.level_min = level if self.level_min is None else min(self.level_min, level)
         self.check_alarms({0: level})
 
-    def debug_metrics(self) -> dict:
+    def debug_metrics(self) -> PscDebug:
         """Debug port: alarms, the mean it reports now, and the lowest mean and judged level of the run (volts)."""
         def volts(raw: int | None) -> float | None:
             return None if raw is None else round(_PSC_V.phys(raw), 3)

@@ -15,7 +15,7 @@ is ignored (6.2).
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, TypedDict
 
 from arachnae_proto import messages as M
 from arachnae_proto.enums import IscAxis, RangeStatus, RecordKind
@@ -71,6 +71,23 @@ def alarm_setup() -> list[tuple[str, M.Message, list[tuple[int, AlarmLimit]]]]:
     m = M.SetAlarmPsc.from_phys(limit=T.SPU_ALARM_PSC_V)                          # seed 3.2.17
     out.append(("PSC", m, [(0, AlarmLimit(limit_in(psc, M.SetAlarmPsc, m.limit), BELOW, 0))]))
     return out
+
+
+class SpuRecords(TypedDict):
+    value: int
+    alarm: int
+    status: int
+
+
+class SpuDebug(TypedDict):
+    """SPU.debug_metrics(): metrics.json `nodes.SPU` (sim2d.metrics checks expectations on it at load)."""
+    records: SpuRecords
+    ignored: int
+    silent: int
+    untrusted_values: int
+    values: dict[str, int]          # role -> records of values forwarded
+    status: dict[str, int]          # role -> its status code
+    posts: int
 
 
 class SPU(PostMaster, Runtime, SpuSkeleton):
@@ -248,7 +265,7 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
         if self.outbox:
             self.ask_bus()
 
-    def debug_metrics(self) -> dict:
+    def debug_metrics(self) -> SpuDebug:
         """Records forwarded per kind, data ignored (6.2), sensors declared silent, and the status of each."""
         return {"records": {k: self.counts[k] for k in ("value", "alarm", "status")},
                 "ignored": self.counts["ignored"], "silent": self.counts["silent"],

@@ -247,10 +247,10 @@ def _decode(args: argparse.Namespace) -> int:
 
     own = _node_address(args.own) if args.own is not None else None
     try:
-        f = frame.parse(data, own)
+        f = frame.parse(data, own)      # size, checksum, address, route (seed 3.2.1), message
+        frame.check_roles(f)            # and the sender's and receiver's roles (spec messages.yaml from/to)
     except CodecError as err:
         raise UserError(f"decode: {err.kind.name}: {err}") from None
-    _check_route(f)
     m = f.message
     print(f"{name_of(f.src)} -> {name_of(f.dst)}  {m.NAME} (opcode 0x{m.OPCODE:02X}, seed {m.SECTION})")
     for info in m.FIELDS:
@@ -275,23 +275,3 @@ def _node_address(text: str) -> int:
                         "(`arachnae spec nodes` lists them)")
     return value
 
-
-def _check_route(f: "object") -> None:
-    """seed 3.2.1: a frame comes from a node and goes to a node, or to broadcast only if its message may be
-    broadcast; the sender and receiver roles are the message's (spec messages.yaml from/to)."""
-    from arachnae_proto.network import BROADCAST, NODES
-
-    m = f.message
-    if f.src not in NODES:
-        raise UserError(f"decode: ADDRESS: source 0x{f.src:02X} is not a node address")
-    if f.dst == BROADCAST:
-        if not m.BROADCAST:
-            raise UserError(f"decode: ADDRESS: {m.NAME} to broadcast 0x{BROADCAST:02X}, but the spec does not "
-                            f"mark {m.NAME} broadcast")
-    elif f.dst not in NODES:
-        raise UserError(f"decode: ADDRESS: destination 0x{f.dst:02X} is not a node address")
-    sender, receiver = NODES[f.src], NODES.get(f.dst)
-    if sender.role not in m.SENDERS:
-        raise UserError(f"decode: ROUTE: {m.NAME} from {sender.short}, but only {', '.join(m.SENDERS)} send it")
-    if receiver is not None and receiver.role not in m.RECEIVERS:
-        raise UserError(f"decode: ROUTE: {m.NAME} to {receiver.short}, but only {', '.join(m.RECEIVERS)} receive it")

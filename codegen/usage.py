@@ -6,7 +6,8 @@ console/, sim2d/ and firmware/. Those layers may not be imported from here, so
 their sources are read as text and searched for the names the generators give a
 message: its Python class (ObjLeft), skeleton hook (on_obj_left), C functions
 (arachnae_obj_left_*) and opcode macro (ARACHNAE_OP_OBJ_LEFT). A message none of
-them mentions is dead weight in the protocol: `spec check` warns, naming it.
+them mentions is dead weight in the protocol: `spec check` warns, naming it. A message
+whose code travels inside another one (`carriers`) is used when that one is.
 """
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ from pathlib import Path
 
 from arachnae.errors import located
 from codegen.generate import REPO
-from codegen.model import Spec
+from codegen.model import Message, Spec
 from codegen.templates.c import MessageView
 from codegen.templates.python import camel
 from arachnae.yamlio import line_of, load_yaml
@@ -33,16 +34,36 @@ def _implementation_text(root: Path) -> str:
     return "\n".join(parts)
 
 
-def unused_messages(spec: Spec, root: Path = REPO) -> list[str]:
-    """Names of the messages no implementation under `root` refers to, in spec order."""
-    text = _implementation_text(root)
-    unused = []
+def carriers(spec: Spec) -> dict[str, str]:
+    """Messages whose code travels inside another message: name -> that carrier's name. The spec says so by
+    giving a flags bit or enum value of a carrier's field the message's name, the carrier going from the same
+    roles to the same roles (seed 3.2.12: the TPSC's OBJ_LEFT, OBJ_RIGHT and OBJ_BOTH are the TPSC_CONTACT
+    bits of XMIT_DATA_TPSC.contact)."""
+    out = {}
     for m in spec.messages:
+        for carrier in spec.messages:
+            if carrier is m or (set(carrier.senders), set(carrier.receivers)) != (set(m.senders), set(m.receivers)):
+                continue
+            for f in carrier.fields:
+                codes = f.flags.bits if f.flags is not None else f.enum.values if f.enum is not None else {}
+                if m.name in codes:
+                    out[m.name] = carrier.name
+    return out
+
+
+def unused_messages(spec: Spec, root: Path = REPO) -> list[str]:
+    """Names of the messages no implementation under `root` refers to, in spec order; a message carried as a
+    code inside another (carriers) counts as used when its carrier is."""
+    text = _implementation_text(root)
+
+    def mentioned(m: Message) -> bool:
         c = MessageView(m, spec.frame.overhead, spec)
         names = (camel(m.name), f"on_{m.name.lower()}", f"{c.prefix}_\\w+", c.op_macro)
-        if not re.search(r"\b(" + "|".join(names) + r")\b", text):
-            unused.append(m.name)
-    return unused
+        return re.search(r"\b(" + "|".join(names) + r")\b", text) is not None
+
+    used = {m.name for m in spec.messages if mentioned(m)}
+    carried = carriers(spec)
+    return [m.name for m in spec.messages if m.name not in used and carried.get(m.name) not in used]
 
 
 def warnings(spec: Spec, root: Path = REPO) -> list[str]:

@@ -291,8 +291,10 @@ def vector_text(spec: Spec) -> str:
         "#   to_milli <NAME> <field> <raw> <milli|RANGE>         RANGE: a raw value outside the field's range",
         "#   refuse <NAME> <case> <ERROR> <field>=<raw> ...      values every encoder must refuse with ERROR, nothing sent",
         "#   bad <case> <own_address_hex> <frame_hex> <ERROR>    whole-frame check and byte parser (fed every byte, then the idle gap)",
-        "# Check order: TRUNCATED/OVERSIZE, CHECKSUM, ADDRESS, OPCODE, LENGTH, RANGE. LENGTH covers a payload size the",
-        "# message cannot have and an array whose count disagrees with the bytes present; a count outside its range is RANGE.",
+        "# Check order: TRUNCATED/OVERSIZE, CHECKSUM, ADDRESS, ROUTE, OPCODE, LENGTH, RANGE. ADDRESS: a frame for another node;",
+        "# ROUTE: a source that is no node, a destination neither node nor broadcast, broadcast on a message not marked so.",
+        "# LENGTH covers a payload size the message cannot have and an array whose count disagrees with the bytes present;",
+        "# a count outside its range is RANGE.",
         "# The byte parser hands a frame over when its last byte arrives; bytes before the idle gap after it are OVERSIZE.",
     ]
     crc = spec.frame.checksum
@@ -315,7 +317,33 @@ def vector_text(spec: Spec) -> str:
     bcast = next(m for m in spec.messages if m.broadcast)
     b_dst, b_src = _route(spec, bcast)
     lines.append(f"msg {bcast.name} broadcast {frame(spec, spec.broadcast, b_src, bcast.opcode, b'').hex()}")
+    lines += _route_lines(spec, unused)
     return "\n".join(lines) + "\n"
+
+
+def _route_lines(spec: Spec, unused_opcode: int) -> list[str]:
+    """seed 3.2.1: frames whose envelope is intact but whose addresses no node of the spec could send:
+    ROUTE, after ADDRESS (a frame for another node is ADDRESS whatever its source) and before OPCODE."""
+    known = {n.address for n in spec.nodes}
+    stranger = next(a for a in range(256) if a not in known and a != spec.broadcast)
+    some = spec.messages[0]
+    dst, src = _route(spec, some)
+    payload = pack(some, _values(spec, some, "min"))
+    single = next(m for m in spec.messages if not m.broadcast)
+    s_dst, s_src = _route(spec, single)
+    s_payload = pack(single, _values(spec, single, "min"))
+    bc = spec.broadcast
+    cases = [
+        ("source_not_node", dst, frame(spec, dst, stranger, some.opcode, payload), "ROUTE"),
+        ("source_broadcast", dst, frame(spec, dst, bc, some.opcode, payload), "ROUTE"),
+        ("source_not_node_any", None, frame(spec, dst, stranger, some.opcode, payload), "ROUTE"),
+        ("destination_not_node", None, frame(spec, stranger, src, some.opcode, payload), "ROUTE"),
+        (f"{single.name}_to_broadcast", s_dst, frame(spec, bc, s_src, single.opcode, s_payload), "ROUTE"),
+        (f"{single.name}_to_broadcast_any", None, frame(spec, bc, s_src, single.opcode, s_payload), "ROUTE"),
+        ("unknown_opcode_to_broadcast", None, frame(spec, bc, src, unused_opcode, b""), "ROUTE"),
+        ("other_node_from_stranger", src, frame(spec, dst, stranger, some.opcode, payload), "ADDRESS"),
+    ]
+    return [f"bad {case} {'-' if own is None else f'{own:02x}'} {data.hex()} {kind}" for case, own, data, kind in cases]
 
 
 __all__ = ["vector_text", "pack", "frame"]

@@ -31,7 +31,7 @@ def seeds(vectors: Path = VECTORS) -> dict[str, bytes]:
         if parts[0] == "msg":
             frame = _hex(parts[3])
             out[f"msg_{parts[1]}_{parts[2]}"] = bytes([frame[0]]) + frame
-        elif parts[0] == "bad":
+        elif parts[0] == "bad" and parts[2] != "-":   # byte 0 names one own address; "any" has no byte
             out[f"bad_{parts[1]}"] = bytes([int(parts[2], 16)]) + _hex(parts[3])
     if not out:
         raise SystemExit(f"{vectors}: no msg or bad lines")

@@ -30,7 +30,7 @@ if str(REPO / "generated" / "python") not in sys.path:
 
 from arachnae_proto import CodecError, ErrorKind, frame  # noqa: E402
 
-ARACHNAE_NONE = 9
+ARACHNAE_NONE = len(ErrorKind)   # the C enum's value after the last error kind
 
 
 def build_c_codec(out_dir: Path) -> ctypes.CDLL:

@@ -1,11 +1,14 @@
 """Metrics of a finished run and the scenario's expectations checked against them."""
 from __future__ import annotations
 
+import functools
 import hashlib
 import math
+import types
 from bisect import bisect_left
-from typing import TYPE_CHECKING, Any, Sequence
+from typing import TYPE_CHECKING, Any, Sequence, Union, get_args, get_origin, get_type_hints, is_typeddict
 
+from behaviours import ROLES
 from sim2d.gait_metrics import motion_schema
 from sim2d.nav_metrics import nav_schema
 
@@ -138,7 +141,33 @@ def _leaves(*names: str) -> dict[str, Any]:
 
 _VALUE: dict[str, Any] = {"type": ["number", "boolean", "null", "array"]}   # a leaf metric (text ones say so)
 _TEXT: dict[str, Any] = {"type": ["string", "null"]}
-_FREE: dict[str, Any] = {"type": "object"}      # a node's own debug-port figures (debug_metrics()): any keys
+_JSON_TYPE = {bool: "boolean", int: "integer", float: "number", str: "string", type(None): "null"}
+
+
+def schema_of(tp: Any) -> dict[str, Any]:
+    """JSON Schema of a type annotation: a TypedDict (its keys, no others), list[X], dict[str, X], a union of
+    scalars, bool, int, float, str, None. A node's debug_metrics() declares its record this way, next to the
+    behaviour; anything else is a TypeError here, so an undeclarable shape is found at once."""
+    if tp in _JSON_TYPE:
+        return {"type": _JSON_TYPE[tp]}
+    if is_typeddict(tp):
+        return _obj({k: schema_of(v) for k, v in get_type_hints(tp).items()})
+    origin, args = get_origin(tp), get_args(tp)
+    if origin is list and len(args) == 1:
+        return {"type": "array", "items": schema_of(args[0])}
+    if origin is dict and len(args) == 2 and args[0] is str:
+        return {"type": "object", "additionalProperties": schema_of(args[1])}
+    if origin in (Union, types.UnionType) and all(a in _JSON_TYPE for a in args):
+        return {"type": [_JSON_TYPE[a] for a in args]}
+    raise TypeError(f"{tp!r}: not a metric type (TypedDict, list[X], dict[str, X], bool, int, float, str, None)")
+
+
+@functools.cache
+def node_schema(role: str) -> dict[str, Any]:
+    """The declared shape of metrics.json `nodes.<NODE>` for a node of `role`: the return type of its behaviour's
+    debug_metrics(), or no keys when it has none (or the role has no behaviour)."""
+    fn = getattr(ROLES.get(role), "debug_metrics", None)
+    return schema_of(get_type_hints(fn)["return"]) if fn is not None else _obj({})
 
 
 def metrics_schema(spec: Any, measured: Sequence[str] = ()) -> dict[str, Any]:
@@ -164,7 +193,7 @@ def metrics_schema(spec: Any, measured: Sequence[str] = ()) -> dict[str, Any]:
         "notes": {"type": "object", "additionalProperties": _leaves("count", "first_s", "last_s", "walked_after_m")},
         "sound": _leaves("events", "final_heading_error_deg"),
         "rcp": _leaves("keys_typed", "screen_bytes"),
-        "nodes": _obj({n.short: _FREE for n in spec.nodes}),
+        "nodes": _obj({n.short: node_schema(n.role) for n in spec.nodes}),
         "motion": motion_schema(),
         **nav_schema(measured),
         # tracecheck.validate.Report.metrics: the run's trace held to the verified protocol (issue 11)
@@ -184,15 +213,13 @@ def metric_path_problem(schema: dict[str, Any], path: str) -> str | None:
     return found if isinstance(found, str) else None
 
 
-def metric_node(schema: dict[str, Any], path: str) -> dict[str, Any] | str | None:
-    """The schema of the metric at `path`, None below a node's own figures (any shape), or why there is none."""
+def metric_node(schema: dict[str, Any], path: str) -> dict[str, Any] | str:
+    """The schema of the metric at `path`, or why there is none."""
     node = schema
     done: list[str] = []
     for part in path.split("."):
         if node.get("type") != "object":
             return f"{'.'.join(done)} is a single value, it has no {part!r}"
-        if node is _FREE:
-            return None
         props = node.get("properties", {})
         nxt = props.get(part, node.get("additionalProperties", False))
         if nxt is False:

@@ -11,7 +11,7 @@ import json
 import os
 import shutil
 import tempfile
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -46,13 +46,17 @@ def load_spec_once() -> Any:
 
 
 def run(path: str, seed: int | None = None, spec: Any = None, gif: bool = False,
-        replace_nodes: dict[str, Any] | None = None, console: Any = None, pace: float | None = None) -> Outcome:
+        replace_nodes: dict[str, Any] | None = None, console: Any = None, pace: float | None = None,
+        max_duration: float | None = None) -> Outcome:
     """`console`: a host terminal line (console.terminal) on the UIC/RCP's RS-232 port; with it, or with
-    `pace` (simulated seconds per wall second), the run keeps to the wall clock."""
+    `pace` (simulated seconds per wall second), the run keeps to the wall clock. `max_duration` cuts the run
+    short (the hostile-input audit starts every scenario it accepts this way)."""
     spec = spec or load_spec_once()
     sc = load_scenario(path, spec)
     if seed is not None:
         sc = sc.with_seed(seed)
+    if max_duration is not None and sc.duration > max_duration:
+        sc = replace(sc, duration=max_duration)
     sim = Simulation(sc, spec, keep_frames_every=GIF_FRAME_S if gif else None, replace_nodes=replace_nodes)
     if console is not None or pace is not None:
         attach_console(sim, console if console is not None else WallClock(), 1.0 if pace is None else pace)

@@ -409,8 +409,7 @@ def _check_metric_paths(doc: LDict, spec: Any) -> None:
             node = metric_node(schema, path)
             if isinstance(node, str):
                 raise locate(doc, where_, f"expect.metrics: {path!r} names no metric: {node}")
-            if node is not None:
-                _check_operands(doc, where_, path, b, node)
+            _check_operands(doc, where_, path, b, node)
         if parts[0] == "nodes" and len(parts) > 1 and parts[1] in absent:
             raise locate(doc, where_, f"expect.metrics: {path!r}: node {parts[1]} is absent in this scenario")
         if "min" in b and "max" in b and b["min"] > b["max"]:
@@ -425,6 +424,8 @@ def _check_operands(doc: LDict, where_: list[Any], path: str, bounds: Any, metri
     valid = Validator(metric).is_valid
     if "eq" in bounds and not valid(bounds["eq"]):
         raise locate(doc, where_ + ["eq"], f"expect.metrics.{path}: eq {bounds['eq']!r} is not a value this metric takes")
+    if metric.get("type") == "integer":     # a count: any number bounds it (min 0.5 means at least 1)
+        valid = Validator({"type": "number"}).is_valid
     for key in ("min", "max"):
         if key in bounds and not valid(bounds[key]):
             raise locate(doc, where_ + [key], f"expect.metrics.{path}: {key} {bounds[key]!r}: this metric is not a number")

@@ -33,12 +33,13 @@ enum {
     ARACHNAE_TRUNCATED = 1, /* fewer bytes than header+crc, or than header+length+crc */
     ARACHNAE_OVERSIZE = 2, /* more bytes than the length byte says, or than the parser's buffer holds */
     ARACHNAE_CHECKSUM = 3, /* CRC mismatch */
-    ARACHNAE_ADDRESS = 4, /* dst is neither the own address nor broadcast */
-    ARACHNAE_OPCODE = 5, /* unknown opcode (or one the role does not receive) */
-    ARACHNAE_LENGTH = 6, /* payload size not valid for the message, or an array count that disagrees with it */
-    ARACHNAE_RANGE = 7, /* a field outside its raw range, enum or flags mask, or not a node address */
-    ARACHNAE_BUFFER = 8, /* caller's output buffer too small */
-    ARACHNAE_NONE = 9 /* parser only: nothing to report yet (not an error) */
+    ARACHNAE_ADDRESS = 4, /* dst is neither the own address nor broadcast: a frame for another node */
+    ARACHNAE_ROUTE = 5, /* src is not a node, dst neither a node nor broadcast, or broadcast on a message the spec does not mark broadcast */
+    ARACHNAE_OPCODE = 6, /* unknown opcode (or one the role does not receive) */
+    ARACHNAE_LENGTH = 7, /* payload size not valid for the message, or an array count that disagrees with it */
+    ARACHNAE_RANGE = 8, /* a field outside its raw range, enum or flags mask, or not a node address */
+    ARACHNAE_BUFFER = 9, /* caller's output buffer too small */
+    ARACHNAE_NONE = 10 /* parser only: nothing to report yet (not an error) */
 };
 /* One byte, not the enum type: an enum is an int, two registers on an 8-bit core (issue 15: -56 bytes
  * of AVR flash for the TPSC). Holds one of the constants above. */
@@ -62,7 +63,7 @@ typedef uint8_t arachnae_status;
 
 /* ---- node addresses (seed 3.2.1, 3.2.18) ---- */
 #define ARACHNAE_ADDR_BROADCAST 0xFFu
-/* Pass as `own` to skip the address check (not a valid 8-bit address). */
+/* Pass as `own` to skip the address check (not an 8-bit address: any own above 0xFF means the same). */
 #define ARACHNAE_ANY_ADDRESS 0xFFFFu
 #define ARACHNAE_ADDR_MCP 0x01u /* MCP, role MCP */
 #define ARACHNAE_ADDR_NP3 0x02u /* NP3, role NP3 */
@@ -401,10 +402,14 @@ typedef uint8_t arachnae_status;
 #define ARACHNAE_ALERT_MASK 0x03u
 
 /* ---- small helpers ---- */
-/* 1 if `a` is the address of a node in the spec (broadcast is not). */
-static inline int arachnae_is_node(uint8_t a)
+/* 1 if `a` is the address of a node in the spec (broadcast is not). A function, not inline: the frame
+ * check and every node-typed field share one copy (flash, issue 15). */
+uint8_t arachnae_is_node(uint8_t a);
+
+/* 1 if the message with this opcode may be sent to broadcast (spec messages.yaml `broadcast`). */
+static inline int arachnae_may_broadcast(uint8_t op)
 {
-    return (a >= 0x01u && a <= 0x08u) || (a >= 0x21u && a <= 0x2Du) || (a >= 0x41u && a <= 0x52u);
+    return op == 0x01u;
 }
 
 /* Two's complement of a `mask`-wide raw value without implementation-defined casts. */
@@ -461,7 +466,7 @@ arachnae_status arachnae_frame_finish(uint8_t *frame, uint16_t cap, uint8_t dst,
  * (Argument order as the generated _build functions', so that they end in a jump here.) */
 arachnae_status arachnae_frame_seal(uint8_t opcode, uint8_t dst, uint8_t src, uint8_t *frame, uint8_t payload_len,
                                     uint16_t *frame_len);
-/* Envelope check: TRUNCATED/OVERSIZE, CHECKSUM, then ADDRESS (own = ARACHNAE_ANY_ADDRESS skips it). */
+/* Envelope check: TRUNCATED/OVERSIZE, CHECKSUM, ADDRESS (own = ARACHNAE_ANY_ADDRESS skips it), then ROUTE. */
 arachnae_status arachnae_frame_check(const uint8_t *frame, uint16_t len, uint16_t own);
 
 /* Frames a node checked but delivered to no callback (issue 10: never dropped silently): how many

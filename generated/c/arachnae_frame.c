@@ -31,6 +31,11 @@ static inline uint16_t crc_step(uint16_t crc, uint8_t byte)
 #endif
 }
 
+uint8_t arachnae_is_node(uint8_t a)
+{
+    return (uint8_t)((a >= 0x01u && a <= 0x08u) || (a >= 0x21u && a <= 0x2Du) || (a >= 0x41u && a <= 0x52u));
+}
+
 uint16_t arachnae_crc16_update(uint16_t crc, uint8_t byte)
 {
     return crc_step(crc, byte);
@@ -76,7 +81,7 @@ arachnae_status arachnae_frame_finish(uint8_t *frame, uint16_t cap, uint8_t dst,
 arachnae_status arachnae_frame_check(const uint8_t *frame, uint16_t len, uint16_t own)
 {
     uint16_t need;
-    uint8_t dst, for_us;
+    uint8_t dst, own_lo = (uint8_t)(own & 0xFFu), own_hi = (uint8_t)(own >> 8);
     if (len < ARACHNAE_FRAME_OVERHEAD)
         return ARACHNAE_TRUNCATED;
     need = (uint16_t)(ARACHNAE_FRAME_OVERHEAD + frame[ARACHNAE_FRAME_LENGTH]);
@@ -84,13 +89,24 @@ arachnae_status arachnae_frame_check(const uint8_t *frame, uint16_t len, uint16_
         return ARACHNAE_TRUNCATED;
     if (len > need)
         return ARACHNAE_OVERSIZE;
-    /* the address verdict before the CRC call, reported after it: one byte lives across the call */
-    dst = frame[ARACHNAE_FRAME_DST];
-    for_us = (uint8_t)(own == ARACHNAE_ANY_ADDRESS || dst == own || dst == ARACHNAE_ADDR_BROADCAST);
     /* MSB-first CRC without xorout: over a good frame with its big-endian CRC it gives 0 */
     if (arachnae_crc16(frame, len) != 0u)
         return ARACHNAE_CHECKSUM;
-    return for_us ? ARACHNAE_OK : ARACHNAE_ADDRESS;
+    /* ADDRESS: for another node. ROUTE (seed 3.2.1): not from a node, or to broadcast with a message the
+     * spec does not mark broadcast, or (own = any) to no node; `own` itself is a node (the skeleton's init) */
+    dst = frame[ARACHNAE_FRAME_DST];
+    if (dst == ARACHNAE_ADDR_BROADCAST) {
+        if (!arachnae_may_broadcast(frame[ARACHNAE_FRAME_OPCODE]))
+            return ARACHNAE_ROUTE;
+    } else if (own_hi == 0u) {  /* not ARACHNAE_ANY_ADDRESS: its high byte alone says so (8-bit compares, flash) */
+        if (dst != own_lo)
+            return ARACHNAE_ADDRESS;
+    } else if (!arachnae_is_node(dst)) {
+        return ARACHNAE_ROUTE;
+    }
+    if (!arachnae_is_node(frame[ARACHNAE_FRAME_SRC]))
+        return ARACHNAE_ROUTE;
+    return ARACHNAE_OK;
 }
 
 /* parser states; READY and HELD, the two with a valid frame, are the highest (one compare) */

@@ -1165,6 +1165,7 @@ const char *arachnae_status_name(arachnae_status st)
         "OVERSIZE",
         "CHECKSUM",
         "ADDRESS",
+        "ROUTE",
         "OPCODE",
         "LENGTH",
         "RANGE",

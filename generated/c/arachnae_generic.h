@@ -103,7 +103,7 @@ int arachnae_field_index(const arachnae_msg_desc *d, const char *name);
 arachnae_status arachnae_payload_check(uint8_t opcode, const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_decode_payload(uint8_t opcode, const uint8_t *payload, uint8_t len, arachnae_message *out);
 arachnae_status arachnae_encode_payload(const arachnae_message *m, uint8_t *payload, uint16_t cap, uint8_t *len);
-/* A whole frame in the shared check order: TRUNCATED/OVERSIZE, CHECKSUM, ADDRESS, OPCODE, LENGTH, RANGE.
+/* A whole frame in the shared check order: TRUNCATED/OVERSIZE, CHECKSUM, ADDRESS, ROUTE, OPCODE, LENGTH, RANGE.
  * h may be NULL. */
 arachnae_status arachnae_frame_decode(const uint8_t *frame, uint16_t len, uint16_t own, arachnae_header *h,
                                       arachnae_message *out);

@@ -46,9 +46,6 @@ static arachnae_status deliver(uic_rcp_node *node, const arachnae_header *h, con
         uic_rcp_on_init(node, h);
         return ARACHNAE_OK;
     case ARACHNAE_OP_ID_REQ:
-        /* requests to broadcast get no reply: every node answering would collide */
-        if (h->dst == ARACHNAE_ADDR_BROADCAST)
-            return ARACHNAE_OK;
         /* seed 3.2.2: ID_ACK carries the node's own address */
         node->msg.reply_id_ack.address = node->address;
         st = arachnae_id_ack_check(&node->msg.reply_id_ack);
@@ -58,8 +55,6 @@ static arachnae_status deliver(uic_rcp_node *node, const arachnae_header *h, con
         n = arachnae_id_ack_pack(&node->msg.reply_id_ack, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
     case ARACHNAE_OP_STATUS_REQ:
-        if (h->dst == ARACHNAE_ADDR_BROADCAST)
-            return ARACHNAE_OK;
         /* seed 3.2.3: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_BUSY) */
         node->msg.reply_status.status = 0;
         uic_rcp_on_status_req(node, h, &node->msg.reply_status);

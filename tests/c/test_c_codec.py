@@ -291,6 +291,7 @@ def test_skeleton_dispatch_and_replies(spec, tmp_path):
     a = {n.short: n.address for n in spec.nodes}
     F = dev_vectors.frame
     bc = spec.broadcast
+    stranger = next(x for x in range(256) if x not in a.values() and x != bc)
     enum = spec.enums
     rx_max = {r: spec.frame.overhead + max(m.max_size for m in spec.receives(r)) for r in ("TPSC", "JAC", "MMC")}
 
@@ -300,8 +301,10 @@ def test_skeleton_dispatch_and_replies(spec, tmp_path):
     cases = [
         # seed 3.2.2: ID_ACK carries the node's own address, back to the requester
         ("tpsc", F(a["TPSC"], a["SPU"], "ID_REQ", []), "OK", [f"send tpsc {hexf(a['SPU'], a['TPSC'], 'ID_ACK', [a['TPSC']])}"]),
-        # a broadcast request gets no reply (all nodes would answer at once)
-        ("tpsc", F(bc, a["SPU"], "ID_REQ", []), "OK", []),
+        # seed 3.2.1: ID_REQ is not a broadcast message (spec): the frame check refuses it (ROUTE), no reply
+        ("tpsc", F(bc, a["SPU"], "ID_REQ", []), "ROUTE", []),
+        # a source that is no node: ROUTE, no callback
+        ("tpsc", F(a["TPSC"], stranger, "XMIT_DATA", []), "ROUTE", []),
         # STATUS_REQ answered with the role's STATUS_ACK variant; TPSC always IN_ORDER (seed 3.2.12)
         ("tpsc", F(a["TPSC"], a["SPU"], "STATUS_REQ", []), "OK",
          [f"send tpsc {hexf(a['SPU'], a['TPSC'], 'STATUS_ACK_ORDER', [enum['ORDER_STATUS'].values['IN_ORDER']])}"]),

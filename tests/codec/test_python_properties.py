@@ -1,10 +1,13 @@
 """Properties of the generated Python codec, over every message of the spec."""
 from __future__ import annotations
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from arachnae_proto import CodecError, frame
+from arachnae_proto.errors import ErrorKind
+from arachnae_proto.network import BROADCAST, NODE_ADDRESSES
 from arachnae_proto.messages import BY_NAME
 
 
@@ -41,11 +44,22 @@ def any_message(spec):
 
 
 def test_encode_then_decode_is_identity(spec) -> None:
+    nodes = st.sampled_from(sorted(NODE_ADDRESSES))
+    address = nodes | st.just(BROADCAST) | st.integers(0, 255)   # mostly routable, every byte possible
+
     @settings(max_examples=3000, deadline=None)
-    @given(msg=any_message(spec), dst=st.integers(0, 255), src=st.integers(0, 255))
+    @given(msg=any_message(spec), dst=address, src=address)
     def check(msg, dst, src):
         assert type(msg).decode(msg.encode()) == msg
-        f = frame.parse(frame.build(dst, src, msg))
+        data = frame.build(dst, src, msg)
+        # seed 3.2.1: from a node, to a node or to broadcast for a broadcast message; otherwise ROUTE
+        routable = src in NODE_ADDRESSES and (dst in NODE_ADDRESSES or (dst == BROADCAST and msg.BROADCAST))
+        if not routable:
+            with pytest.raises(CodecError) as err:
+                frame.parse(data)
+            assert err.value.kind == ErrorKind.ROUTE
+            return
+        f = frame.parse(data)
         assert (f.dst, f.src, f.message) == (dst, src, msg)
 
     check()

@@ -92,3 +92,23 @@ def test_unhandled_and_unexpected_messages_are_counted_and_noted(spec) -> None:
     for _ in range(100):
         rlc.receive("first", frame.build(rlc.address, mcp, M.XmitGrant()))
     assert rlc.unhandled["XMIT_GRANT"] == 102 and len(rlc.notes) < 100   # the trace is bounded, the count is not
+
+
+def test_frames_no_node_could_send_are_codec_errors_not_foreign_frames(spec) -> None:
+    """seed 3.2.1: a frame for us from an address that is no node, or a non-broadcast message to broadcast, is
+    reported (ROUTE) to on_codec_error; a frame for another node is ignored (ADDRESS)."""
+    errors = []
+    cls = skeleton_class("MMC")
+
+    class Behaviour(cls):
+        def on_codec_error(self, bus, err):
+            errors.append(err.kind.name)
+
+    mmc = Behaviour(spec.node("MMC").address, lambda bus, data: None)
+    mcp = spec.node("MCP").address
+    stranger = next(a for a in range(256) if a not in {n.address for n in spec.nodes} and a != spec.broadcast)
+    move = M.MoveRelayed(address=spec.node("NP3").address, mov_cmd=1)
+    assert mmc.receive("first", frame.build(mmc.address, stranger, move)) is None
+    assert mmc.receive("first", frame.build(spec.broadcast, mcp, move)) is None     # MOVE_RELAYED is not broadcast
+    assert mmc.receive("first", frame.build(spec.node("SPU").address, stranger, move)) is None   # not ours
+    assert errors == ["ROUTE", "ROUTE"]

@@ -9,8 +9,12 @@ Each probe is one input a user could give, with what the contract asks of it:
 Outcomes: `refused` (a one-line UserError), `accepted`, `traceback` (any other exception), `long` (refused
 with more than one line). The contract is 0 tracebacks, 0 bad inputs accepted and 0 long refusals.
 
-`python -m tests.hostile.audit` prints the table for every surface and lists each failure;
-tests/hostile/test_audit.py asserts the contract on the same probes.
+Surface `run`: scenario mutants the loader accepted are started as `sim run --out` would start them, cut
+to RUN_CAP_S of simulated time (a sample of them: QUICK.runs, FULL.runs): no traceback, and the output folder
+is whole (marker, metrics.json) with nothing half-written beside it.
+
+`python -m tests.hostile.audit [--full] [-j N]` prints the table for every surface and lists each failure
+(-j: forked worker processes); tests/hostile/test_audit.py asserts the contract on the quick set.
 """
 from __future__ import annotations
 
@@ -47,6 +51,7 @@ class Outcome(NamedTuple):
     probe: Probe
     kind: str                   # refused | accepted | traceback | long
     detail: str
+    value: Any = None           # what an accepted probe returned (a scenario's run, to be started later)
 
     @property
     def failed(self) -> bool:
@@ -55,13 +60,13 @@ class Outcome(NamedTuple):
 
 def run_probe(probe: Probe) -> Outcome:
     try:
-        probe.run()
+        value = probe.run()
     except UserError as exc:
         text = str(exc)
         return Outcome(probe, "refused" if _one_line_each(probe, text) else "long", text)
     except Exception as exc:  # noqa: BLE001 - the audit counts exactly these
         return Outcome(probe, "traceback", f"{type(exc).__name__}: {exc}")
-    return Outcome(probe, "accepted", "")
+    return Outcome(probe, "accepted", "", value)
 
 
 _LOCATED = re.compile(r"^\S+:\d+: \S")
@@ -152,22 +157,12 @@ def without(doc: Any, path: tuple) -> Any:
     return out
 
 
-# A node's own debug figures (metrics.json `nodes.<NODE>.*`) have no declared shape, so an expectation on
-# them cannot be type-checked before the run; a wrong operand there fails the run's expectation at its end.
-# This is the one place the audit does not demand a load-time refusal (docs/security.md says so).
-_FREE_FORM = ("expect", "metrics")
-
-
-def _free_form(path: tuple) -> bool:
-    return path[:2] == _FREE_FORM and len(path) > 2 and str(path[2]).startswith("nodes.")
-
-
 def doc_mutants(doc: Any) -> Iterator[tuple[str, Any, bool]]:
     """(label, mutated document, certainly bad) for every node and every mutation of it."""
     for path, value in leaves(doc):
         where = ".".join(str(p) for p in path)
         for m in mutations(value):
-            yield f"{where}: {m.label}", with_value(doc, path, m.value), m.bad and not _free_form(path)
+            yield f"{where}: {m.label}", with_value(doc, path, m.value), m.bad
         if isinstance(path[-1], str):
             yield f"{where}: removed", without(doc, path), False
 
@@ -177,9 +172,11 @@ def dump(doc: Any) -> str:
 
 
 # -- surfaces ---------------------------------------------------------------------------------------
-def _file_probes(surface: str, work: Path, bases: list[Path], load: Callable[[Path], Any]) -> Iterator[Probe]:
+def _file_probes(surface: str, work: Path, bases: list[Path], load: Callable[[Path], Any],
+                 then: Callable[[Path], Any] | None = None) -> Iterator[Probe]:
     """Every mutation of every node of each base file, written beside it in a copy of scenarios/ (so its
-    includes resolve) and given to `load`, as the command would."""
+    includes resolve) and given to `load`, as the command would. With `then`, an accepted mutant returns
+    a callable that writes it again and gives it to `then` (the audit starts a sample of them)."""
     root = work / "scenarios"
     if not root.exists():
         shutil.copytree(SCENARIOS, root)
@@ -187,19 +184,52 @@ def _file_probes(surface: str, work: Path, bases: list[Path], load: Callable[[Pa
         doc = yaml.safe_load(base.read_text(encoding="utf-8"))
         folder = root / base.parent.relative_to(SCENARIOS)
         for i, (label, mutant, bad) in enumerate(doc_mutants(doc)):
-            def run(path=folder / f"audit_{base.stem}_{i}.yaml", text=dump(mutant)):
+            def with_file(use: Callable[[Path], Any], path=folder / f"audit_{base.stem}_{i}.yaml",
+                          text=dump(mutant)) -> Any:
                 path.write_text(text, encoding="utf-8")
                 try:
-                    load(path)
+                    return use(path)
                 finally:
                     path.unlink()
+
+            def run(with_file=with_file) -> Any:
+                with_file(load)
+                return (lambda: with_file(then)) if then is not None else None
             yield Probe(surface, f"{base.name} {label}", run, bad)
 
 
+RUN_CAP_S = 2.0     # simulated seconds of each accepted scenario the audit starts
+
+
+def simulate(path: Path, spec: Any, out: Path) -> None:
+    """`sim run PATH --out OUT`, cut to RUN_CAP_S: a UserError is a refusal; afterwards OUT must be a whole run
+    (its marker and metrics.json) and nothing half-written may be left beside it."""
+    import json
+
+    from sim2d import runner
+
+    runner.write_outputs(runner.run(str(path), spec=spec, max_duration=RUN_CAP_S), out)
+    leftovers = [p.name for p in out.parent.iterdir() if p.name.startswith(f".{out.name}.")]
+    if leftovers or not (out / runner.RUN_MARKER).is_file():
+        raise RuntimeError(f"half-written output: {leftovers or 'no ' + runner.RUN_MARKER}")
+    json.loads((out / "metrics.json").read_text())
+
+
 def scenario_probes(work: Path, files: list[str], spec: Any) -> Iterator[Probe]:
-    """Scenario files, loaded as `sim run` loads them."""
+    """Scenario files, loaded as `sim run` loads them; an accepted one can then be run (run_probes)."""
     from sim2d.scenario import load_scenario
-    yield from _file_probes("scenario", work, [SCENARIOS / f for f in files], lambda p: load_scenario(p, spec))
+    runs = work / "runs"
+    runs.mkdir(exist_ok=True)
+    yield from _file_probes("scenario", work, [SCENARIOS / f for f in files], lambda p: load_scenario(p, spec),
+                            lambda p: simulate(p, spec, runs / p.stem))
+
+
+def run_probes(outcomes: list[Outcome], count: int | None, rng: random.Random) -> list[Probe]:
+    """The accepted scenario mutants started for RUN_CAP_S (a sample of `count`, or all): surface `run`."""
+    accepted = [o for o in outcomes if o.kind == "accepted" and callable(o.value)]
+    if count is not None and len(accepted) > count:
+        accepted = rng.sample(accepted, count)
+    return [Probe("run", o.probe.name, o.value, False) for o in accepted]
 
 
 def sweep_probes(work: Path, spec: Any) -> Iterator[Probe]:
@@ -294,23 +324,60 @@ def cli_probes(work: Path) -> Iterator[Probe]:
         yield Probe("cli", " ".join(argv).replace(str(work), "TMP"), lambda argv=argv: run_cli(*argv), bad)
 
 
-def all_probes(work: Path, full: bool = False) -> Iterator[Probe]:
+class Plan(NamedTuple):
+    """How much the audit tries: the quick set (tests/hostile/test_audit.py) or --full."""
+    scenarios: list[str] | None     # scenario files (None: every one in scenarios/)
+    spec_per_file: int              # sampled mutations of each spec file (the spec check takes ~1 s each)
+    frames: int
+    console: int
+    runs: int | None                # accepted scenario mutants started (None: all of them)
+
+
+QUICK = Plan(["default.yaml", "fault_battery.yaml", "worst_contention.yaml"], 40, 100, 300, 4)
+FULL = Plan(None, 300, 400, 2000, 120)
+
+
+def all_probes(work: Path, plan: Plan, rng: random.Random) -> Iterator[Probe]:
     from codegen.load import load_spec
     spec = load_spec(None)
-    rng = random.Random(10)
-    files = sorted(p.name for p in SCENARIOS.glob("*.yaml")) if full else \
-        ["default.yaml", "fault_battery.yaml", "worst_contention.yaml"]
+    files = plan.scenarios or sorted(p.name for p in SCENARIOS.glob("*.yaml"))
     yield from scenario_probes(work, files, spec)
     yield from sweep_probes(work, spec)
-    yield from spec_probes(work, None if full else 40, rng)
-    yield from frame_probes(rng, 400 if full else 100)
-    yield from console_probes(rng, 2000 if full else 300)
+    yield from spec_probes(work, plan.spec_per_file, rng)
+    yield from frame_probes(rng, plan.frames)
+    yield from console_probes(rng, plan.console)
     yield from cli_probes(work)
 
 
-def audit(full: bool = False) -> list[Outcome]:
+_PROBES: list[Probe] = []       # the probes a forked worker runs, by index
+
+
+def _run_index(i: int) -> tuple[str, str, bool]:
+    o = run_probe(_PROBES[i])
+    return o.kind, o.detail, callable(o.value)
+
+
+def _run_all(probes: list[Probe], jobs: int) -> list[Outcome]:
+    """Run the probes, in `jobs` forked processes when more than one (closures cannot be pickled: the
+    workers inherit them). A worker's accepted scenario keeps no value: its run is started in the parent."""
+    if jobs <= 1:
+        return [run_probe(p) for p in probes]
+    import multiprocessing
+
+    _PROBES[:] = probes
+    with multiprocessing.get_context("fork").Pool(jobs) as pool:
+        results = pool.map(_run_index, range(len(probes)), chunksize=8)
+    return [Outcome(p, kind, detail, (lambda p=p: p.run()()) if runnable else None)
+            for p, (kind, detail, runnable) in zip(probes, results)]
+
+
+def audit(full: bool = False, jobs: int = 1) -> list[Outcome]:
+    """Every probe of the plan; then a sample of the scenarios the loader accepted, started (surface `run`)."""
+    plan = FULL if full else QUICK
+    rng = random.Random(10)
     with tempfile.TemporaryDirectory(prefix="arachnae-audit-") as tmp:
-        return [run_probe(p) for p in all_probes(Path(tmp), full)]
+        outcomes = _run_all(list(all_probes(Path(tmp), plan, rng)), jobs)
+        return outcomes + _run_all(run_probes(outcomes, plan.runs, rng), jobs)
 
 
 def table(outcomes: list[Outcome]) -> str:
@@ -329,7 +396,9 @@ def table(outcomes: list[Outcome]) -> str:
 
 
 def main(argv: list[str]) -> int:
-    outcomes = audit(full="--full" in argv)
+    """python -m tests.hostile.audit [--full] [-j N]"""
+    jobs = int(argv[argv.index("-j") + 1]) if "-j" in argv else 1
+    outcomes = audit(full="--full" in argv, jobs=jobs)
     print(table(outcomes))
     failures = [o for o in outcomes if o.failed]
     for o in failures:

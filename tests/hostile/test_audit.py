@@ -11,5 +11,7 @@ def test_no_traceback_no_silent_acceptance():
     failures = [f"{o.kind}: [{o.probe.surface}] {o.probe.name} -> {o.detail[:200]}" for o in outcomes if o.failed]
     assert not failures, table(outcomes) + "\n" + "\n".join(failures)
     surfaces = {o.probe.surface for o in outcomes}
-    assert surfaces == {"scenario", "sweep", "spec", "frame", "console", "cli"}
+    assert surfaces == {"scenario", "sweep", "spec", "frame", "console", "cli", "run"}
+    runs = [o for o in outcomes if o.probe.surface == "run"]
+    assert len(runs) == 4 and all(o.kind == "accepted" for o in runs)     # started, ran and wrote a whole run
     assert sum(o.kind == "refused" for o in outcomes) > 500      # the probes reach the checks, not just argparse

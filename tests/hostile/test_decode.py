@@ -44,8 +44,8 @@ def test_decode_accepts_what_the_spec_allows(cli, dst, src, own):
 
 
 def test_every_frame_of_a_run_passes_the_address_and_route_checks(tmp_path, spec):
-    """No false alarm: what the simulated robot really sends (a 3 s run) decodes without a route error."""
-    from captures.cli import _check_route
+    """No false alarm: what the simulated robot really sends (a 3 s run) passes the codec's address and route
+    checks and the role check `decode` adds."""
     from sim2d.scenario import load_scenario
     from sim2d.sim import Simulation
 
@@ -54,7 +54,6 @@ def test_every_frame_of_a_run_passes_the_address_and_route_checks(tmp_path, spec
     result = Simulation(load_scenario(path, spec), spec).run()
     checked = 0
     for entry in result.frames:
-        f = frame.parse(entry.sent)
-        _check_route(f)
+        frame.check_roles(frame.parse(entry.sent))
         checked += 1
     assert checked > 300

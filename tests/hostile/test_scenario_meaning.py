@@ -1,8 +1,11 @@
 """Issue 10, item 5: scenarios are checked for meaning at load time, before any run starts."""
 from __future__ import annotations
 
+from typing import TypedDict
+
 import pytest
 
+from arachnae.errors import UserError
 from sim2d.geometry import is_convex
 from sim2d.scenario import load_scenario
 from tests.hostile.conftest import assert_one_line_error, snapshot
@@ -55,6 +58,28 @@ CASES = [
 ]
 
 
+# A node's own debug figures are typed by its behaviour's debug_metrics() record (e.g. behaviours.mmc.MmcDebug).
+# Checked in process (the CLI path of the same check is covered above): (name, expect.metrics line, fragment)
+NODE_CASES = [
+    ("unknown figure", "{nodes.MMC.legz: {eq: 6}}", "nodes.MMC has no 'legz'"),
+    ("figure of the wrong type", "{nodes.MMC.error: {eq: 3}}", "eq 3 is not a value"),
+    ("min on a text figure", "{nodes.USRC.status: {min: 1}}", "this metric is not a number"),
+    ("below a single figure", "{nodes.SPU.ignored.x: {max: 1}}", "nodes.SPU.ignored is a single value"),
+    ("node without debug figures", "{nodes.TPSC.alarms: {max: 0}}", "nodes.TPSC has no 'alarms'"),
+    ("text where a flag is", "{nodes.MCP.halted: {eq: maybe}}", "eq 'maybe' is not a value"),
+]
+
+
+@pytest.mark.parametrize("name, metrics, fragment", NODE_CASES, ids=[c[0] for c in NODE_CASES])
+def test_node_debug_figures_are_checked_at_load(tmp_path, spec, name, metrics, fragment):
+    path = tmp_path / "bad.yaml"
+    path.write_text(ROOM + f"expect: {{metrics: {metrics}}}\n")
+    with pytest.raises(UserError) as err:
+        load_scenario(path, spec)
+    text = str(err.value)
+    assert len(text.splitlines()) == 1 and text.startswith(f"{path}:4: ") and fragment in text, text
+
+
 def _scenario(extra: str) -> str:
     if extra.startswith("robot:"):
         return ROOM.replace("robot: {pose: [1, 1.5, 0]}", extra.rstrip("\n")) + "\n"
@@ -78,6 +103,41 @@ def test_the_room_itself_loads(tmp_path, spec):
     path.write_text(ROOM + "expect: {metrics: {nodes.MMC.legs: {eq: 6}, notes.escape.count: {max: 0},"
                            " motion.TRIPOD.FORWARD.fwd_m: {min: 0.1}, buses.leg.load: {max: 0.5}}}\n")
     assert load_scenario(path, spec).expect.metrics["nodes.MMC.legs"] == {"eq": 6.0}
+
+
+def test_node_debug_figures_take_typed_bounds(tmp_path, spec):
+    """Counts take any number as a bound, text figures text, mappings any key (a leg, a layer, a node)."""
+    path = tmp_path / "ok.yaml"
+    path.write_text(ROOM + "expect: {metrics: {nodes.MMC.error: {eq: NONE}, nodes.MMC.pits: {max: 0.5},"
+                           " nodes.NP3.takeovers.pit: {max: 0}, nodes.MCP.faults.USRC: {eq: 0},"
+                           " nodes.PSC.mean_min_v: {min: 4.5}, nodes.NP3.light.ratio: {min: 1}}}\n")
+    assert load_scenario(path, spec).expect.metrics["nodes.MMC.pits"] == {"max": 0.5}
+
+
+class _Inner(TypedDict, total=False):
+    ratio: float
+
+
+class _Record(TypedDict):
+    count: int
+    name: str | None
+    legs: list[int]
+    by_leg: dict[str, bool]
+    inner: _Inner
+
+
+def test_schema_of_declares_typed_records_and_refuses_what_json_cannot_hold():
+    from sim2d.metrics import schema_of
+
+    assert schema_of(_Record) == {
+        "type": "object", "additionalProperties": False, "properties": {
+            "count": {"type": "integer"}, "name": {"type": ["string", "null"]},
+            "legs": {"type": "array", "items": {"type": "integer"}},
+            "by_leg": {"type": "object", "additionalProperties": {"type": "boolean"}},
+            "inner": {"type": "object", "additionalProperties": False, "properties": {"ratio": {"type": "number"}}}}}
+    for wrong in (tuple[int, int], dict[int, int], set, object):
+        with pytest.raises(TypeError, match="not a metric type"):
+            schema_of(wrong)
 
 
 def test_a_concave_obstacle_is_solid_where_its_hull_would_be_wrong(tmp_path):

@@ -513,6 +513,7 @@ def view(spec: Spec) -> dict:
         "errors": ERROR_KINDS,
         "nodes": [(n.ident, n.address, n.short, n.role) for n in spec.nodes],
         "node_cond": filters.runs_condition("a", filters.runs(node_addrs)),
+        "broadcast_cond": filters.runs_condition("op", filters.runs([m.opcode for m in spec.messages if m.broadcast])),
         "broadcast": spec.broadcast,
         "hash32": spec.hash32,
         "enums": spec.enums,

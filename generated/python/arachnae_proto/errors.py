@@ -9,11 +9,12 @@ class ErrorKind(enum.IntEnum):
     TRUNCATED = 1  # fewer bytes than header+crc, or than header+length+crc
     OVERSIZE = 2  # more bytes than the length byte says, or than the parser's buffer holds
     CHECKSUM = 3  # CRC mismatch
-    ADDRESS = 4  # dst is neither the own address nor broadcast
-    OPCODE = 5  # unknown opcode (or one the role does not receive)
-    LENGTH = 6  # payload size not valid for the message, or an array count that disagrees with it
-    RANGE = 7  # a field outside its raw range, enum or flags mask, or not a node address
-    BUFFER = 8  # caller's output buffer too small
+    ADDRESS = 4  # dst is neither the own address nor broadcast: a frame for another node
+    ROUTE = 5  # src is not a node, dst neither a node nor broadcast, or broadcast on a message the spec does not mark broadcast
+    OPCODE = 6  # unknown opcode (or one the role does not receive)
+    LENGTH = 7  # payload size not valid for the message, or an array count that disagrees with it
+    RANGE = 8  # a field outside its raw range, enum or flags mask, or not a node address
+    BUFFER = 9  # caller's output buffer too small
 
 
 class CodecError(ValueError):

@@ -3,13 +3,14 @@
 """Frames: dst, src, opcode, length, payload, CRC (seed 3.2.2, docs/decisions.md D1).
 
 Checks run in a fixed order, the same as the C codec's: size, checksum,
-address, opcode, payload length, field ranges.
+address (for us?), route (node to node, broadcast only where the spec allows it),
+opcode, payload length, field ranges.
 """
 import binascii
 
 from arachnae_proto.errors import CodecError, ErrorKind
 from arachnae_proto.messages import BY_OPCODE, Message
-from arachnae_proto.network import BROADCAST
+from arachnae_proto.network import BROADCAST, NODE_ADDRESSES, NODES
 
 from arachnae_proto import SPEC_HASH as _PACKAGE_HASH
 
@@ -21,6 +22,8 @@ OVERHEAD = HEADER_SIZE + CRC_SIZE
 MAX_PAYLOAD = 255
 MAX_FRAME = 261
 CRC_NAME = "CRC-16/IBM-3740"
+# seed 3.2.1: the messages a master may send to broadcast (spec messages.yaml `broadcast: true`)
+BROADCAST_OPCODES = frozenset(m.OPCODE for m in BY_OPCODE.values() if m.BROADCAST)
 _crc_hqx = binascii.crc_hqx
 
 
@@ -59,7 +62,7 @@ def build(dst: int, src: int, message: Message) -> bytes:
 
 
 def check(data: bytes, own: int | None = None) -> tuple:
-    """Check size, checksum and address; return (dst, src, opcode, payload) without decoding."""
+    """Check size, checksum, address and route; return (dst, src, opcode, payload) without decoding."""
     n = len(data)
     if n < OVERHEAD:
         raise CodecError(ErrorKind.TRUNCATED, f"frame of {n} bytes is shorter than the {OVERHEAD}-byte minimum")
@@ -71,9 +74,39 @@ def check(data: bytes, own: int | None = None) -> tuple:
     if crc(data[:-CRC_SIZE]) != int.from_bytes(data[-CRC_SIZE:], "big"):
         raise CodecError(ErrorKind.CHECKSUM, f"checksum 0x{int.from_bytes(data[-CRC_SIZE:], 'big'):0{2 * CRC_SIZE}X} does not match, expected 0x{crc(data[:-CRC_SIZE]):0{2 * CRC_SIZE}X}")
     dst = data[0]
-    if own is not None and dst != own and dst != BROADCAST:
-        raise CodecError(ErrorKind.ADDRESS, f"frame for 0x{dst:02X}, not for 0x{own:02X}")
-    return dst, data[1], data[2], data[HEADER_SIZE:-CRC_SIZE]
+    src, opcode = data[1], data[2]
+    check_route(dst, src, opcode, own)
+    return dst, src, opcode, data[HEADER_SIZE:-CRC_SIZE]
+
+
+def check_route(dst: int, src: int, opcode: int, own: int | None = None) -> None:
+    """ADDRESS: a frame for another node than `own` (itself a node). ROUTE (seed 3.2.1): not from a node, or to
+    broadcast with a message the spec does not mark broadcast, or (no `own`) to no node. As the C codec's
+    arachnae_frame_check, in the same order."""
+    if dst == BROADCAST:
+        if opcode not in BROADCAST_OPCODES:
+            cls = BY_OPCODE.get(opcode)
+            what = cls.NAME if cls is not None else f"opcode 0x{opcode:02X}"
+            raise CodecError(ErrorKind.ROUTE, f"{what} to broadcast 0x{BROADCAST:02X}, but the spec does not mark {what} broadcast")
+    elif own is not None:
+        if dst != own:
+            raise CodecError(ErrorKind.ADDRESS, f"frame for 0x{dst:02X}, not for 0x{own:02X}")
+    elif dst not in NODE_ADDRESSES:
+        raise CodecError(ErrorKind.ROUTE, f"destination 0x{dst:02X} is not a node address")
+    if src not in NODE_ADDRESSES:
+        raise CodecError(ErrorKind.ROUTE, f"source 0x{src:02X} is not a node address")
+
+
+def check_roles(f: Frame) -> None:
+    """The sender's and receiver's roles against the message's (spec messages.yaml from/to): CodecError (ROUTE)
+    when they differ. A further check for tools that read a whole bus (`arachnae decode`); the C codec and
+    parse() leave it to the node, whose skeleton counts a message its role does not receive as unexpected."""
+    m = f.message
+    sender, receiver = NODES[f.src], NODES.get(f.dst)
+    if sender.role not in m.SENDERS:
+        raise CodecError(ErrorKind.ROUTE, f"{m.NAME} from {sender.short}, but only {', '.join(m.SENDERS)} send it")
+    if receiver is not None and receiver.role not in m.RECEIVERS:
+        raise CodecError(ErrorKind.ROUTE, f"{m.NAME} to {receiver.short}, but only {', '.join(m.RECEIVERS)} receive it")
 
 
 def parse(data: bytes, own: int | None = None) -> Frame:
