@@ -151,8 +151,12 @@ def _check(args) -> int:
         raise UserError(f"{' and '.join(modes)}: choose one search mode")
     try:
         return run_check(args)
-    except OSError as exc:                  # e.g. the --promela folder filled up or vanished mid-run
-        raise UserError(f"--promela {args.promela}: cannot write ({exc.strerror or exc})") from None
+    except BrokenPipeError:
+        raise                               # stdout piped into `head`: arachnae.cli ends quietly
+    except OSError as exc:
+        if args.promela:                    # e.g. the --promela folder filled up or vanished mid-run
+            raise UserError(f"--promela {args.promela}: cannot write ({exc.strerror or exc})") from None
+        raise UserError(f"check: {exc.filename or 'output'}: {exc.strerror or exc}") from None
 
 
 def _timing(args) -> int:
