@@ -208,7 +208,8 @@ class NP3(Runtime, Np3Skeleton):
         self.next_plan = now + T.NP3_EXPLORE_PLAN_S
         self.map.plan = []
         if self.cfg.task == "seek_light":          # searching for a light it cannot see: the nearest unknown
-            self.goal = self.route_to_frontier(x, y)   # first, round walls by the map (a lamp behind a wall)
+            # the widest opening onto the unknown first, round walls by the map (a lamp behind a wall)
+            self.goal = self.route_to_frontier(x, y, T.NP3_SEEK_FRONTIER_WEIGHT_M)
             if self.goal is not None:
                 self.layers.sense(goal=self.goal)
                 return
@@ -233,10 +234,12 @@ class NP3(Runtime, Np3Skeleton):
             self.goal = self.route_to_frontier(x, y)
         self.layers.sense(goal=self.goal)
 
-    def route_to_frontier(self, x: float, y: float) -> tuple[float, float] | None:
-        """seed 3.3.2: plan over the rebuilt topological map to the nearest frontier; its first waypoint."""
+    def route_to_frontier(self, x: float, y: float, size_weight: float = 0.0) -> tuple[float, float] | None:
+        """seed 3.3.2: plan over the rebuilt topological map to the nearest frontier (`size_weight`: m of path a
+        cell of frontier is worth, TopoMap.frontier); its first waypoint."""
         self.map.rebuild()
-        frontier = self.map.frontier(x, y, min_size=T.NP3_PLAN_MIN_FRONTIER, min_path_m=T.NP3_PLAN_MIN_PATH_M)
+        frontier = self.map.frontier(x, y, min_size=T.NP3_PLAN_MIN_FRONTIER, min_path_m=T.NP3_PLAN_MIN_PATH_M,
+                                     size_weight=size_weight)
         route = self.map.route((x, y), (frontier.x, frontier.y)) if frontier is not None else None
         while route and math.dist(route[0], (x, y)) < T.NP3_GOAL_REACHED_M:
             route.pop(0)
@@ -407,8 +410,8 @@ class NP3(Runtime, Np3Skeleton):
         turned = self.turned_deg()
         if abs(rel) <= T.NP3_SONAR_AHEAD_DEG and d is not None and turned <= T.NP3_SONAR_TURN_DEG:
             self.sonar_ahead = (self.now, d)
-        if d is not None and d < T.NP3_ECHO_NEAR_M and turned <= T.NP3_SONAR_TURN_DEG:
-            self.echo(0.0, 0.0, rel, d, T.NP3_SONAR_BEAM_DEG)
+        if d is not None and d < T.NP3_ECHO_NEAR_M:     # the angle is known to within the beam and the swing
+            self.echo(0.0, 0.0, rel, d, T.NP3_SONAR_BEAM_DEG + 2 * turned)
         half, n = T.NP3_SONAR_BEAM_DEG / 2, 5
         cone = [Reading(x, y, math.degrees(th), head_deg - half + 2 * half * k / (n - 1), d) for k in range(n)]
         self.map.add(cone)
@@ -416,8 +419,9 @@ class NP3(Runtime, Np3Skeleton):
     def turned_deg(self) -> float:
         """How far (deg) the dead-reckoned heading swung over the last NP3_SONAR_LAG_S. A sector minimum reaches
         the NP3 up to that long after its ping (measured, issue 17), so while the body turns its head angle is no
-        longer where the echo was: put into the local memory at the present heading, a wall beside a narrow
-        corridor lands inside the legs' corridor and avoidance and the guard dither against it."""
+        longer where the echo was: put into the local memory at the present heading with only the beam's width
+        as its arc, a wall beside a narrow corridor lands inside the legs' corridor and avoidance and the guard
+        dither against it. The swing widens the echo's arc instead (the guard still sees it as solid)."""
         now, th = self.now, self.odo.th
         self.headings.append((now, th))
         while self.headings and now - self.headings[0][0] > T.NP3_SONAR_LAG_S:
