@@ -114,7 +114,6 @@ class NP3(Runtime, Np3Skeleton):
         self.ir_fault = False
         self.sonar_ignored = False
         self.sonar_ahead: tuple[float, float] | None = None    # (time, metres)
-        self.headings: deque[tuple[float, float]] = deque()    # (time, DR heading) over the sonar's lag
         self.records = 0
         self.lux: list[float] = []
         self.next_plan = 0.0
@@ -140,7 +139,6 @@ class NP3(Runtime, Np3Skeleton):
         x, y, th = self.odo.pose
         self.map.grid.mark_free(x, y, self.body_r)
         self.map.visit(x, y)
-        self.turned_deg()                           # the heading history the sonar's echoes are judged by
         ahead = self.sonar_ahead
         fresh = ahead is not None and now - ahead[0] <= T.NP3_SONAR_FRESH_S and not self.sonar_ignored
         while self.echoes and now - self.echoes[0][0] > T.NP3_ECHO_KEEP_S:
@@ -407,27 +405,13 @@ class NP3(Runtime, Np3Skeleton):
         self.odo.advance(self.now)
         x, y, th = self.odo.pose
         rel = (head_deg + 180) % 360 - 180
-        turned = self.turned_deg()
-        if abs(rel) <= T.NP3_SONAR_AHEAD_DEG and d is not None and turned <= T.NP3_SONAR_TURN_DEG:
+        if abs(rel) <= T.NP3_SONAR_AHEAD_DEG and d is not None:
             self.sonar_ahead = (self.now, d)
-        if d is not None and d < T.NP3_ECHO_NEAR_M:     # the angle is known to within the beam and the swing
-            self.echo(0.0, 0.0, rel, d, T.NP3_SONAR_BEAM_DEG + 2 * turned)
+        if d is not None and d < T.NP3_ECHO_NEAR_M:
+            self.echo(0.0, 0.0, rel, d, T.NP3_SONAR_BEAM_DEG)
         half, n = T.NP3_SONAR_BEAM_DEG / 2, 5
         cone = [Reading(x, y, math.degrees(th), head_deg - half + 2 * half * k / (n - 1), d) for k in range(n)]
         self.map.add(cone)
-
-    def turned_deg(self) -> float:
-        """How far (deg) the dead-reckoned heading swung over the last NP3_SONAR_LAG_S. A sector minimum reaches
-        the NP3 up to that long after its ping (measured, issue 17), so while the body turns its head angle is no
-        longer where the echo was: put into the local memory at the present heading with only the beam's width
-        as its arc, a wall beside a narrow corridor lands inside the legs' corridor and avoidance and the guard
-        dither against it. The swing widens the echo's arc instead (the guard still sees it as solid)."""
-        now, th = self.now, self.odo.th
-        self.headings.append((now, th))
-        while self.headings and now - self.headings[0][0] > T.NP3_SONAR_LAG_S:
-            self.headings.popleft()
-        swing = [abs((a - th + math.pi) % (2 * math.pi) - math.pi) for _t, a in self.headings]
-        return math.degrees(max(swing, default=0.0))
 
     # --- debug port --------------------------------------------------------------------------------
     def debug_metrics(self) -> dict[str, Any]:

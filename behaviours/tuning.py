@@ -77,10 +77,6 @@ NP3_AVOID_SONAR_M = 0.35      # ... or the sonar, looking ahead (+-15 deg), this
 NP3_AVOID_TURN_S = 0.8        # one half cycle of turning per avoidance
 NP3_SONAR_AHEAD_DEG = 15      # a sonar reading this close to the body axis counts as "ahead"
 NP3_SONAR_FRESH_S = 1.5       # ... while it is this recent
-NP3_SONAR_LAG_S = 0.6         # a sector minimum reaches the NP3 up to this long after its ping (measured: median
-                              # 0.24 s, max 0.57 s, corridor_narrow) ...
-NP3_SONAR_TURN_DEG = 4.0      # ... so an echo that arrives while the heading swung more than this over that time
-                              # is not "ahead" (and every echo's arc widens by the swing: its angle is off by it)
 NP3_PIT_BACK_S = 2.4          # pit (MMC NO_GROUND): back off ...
 NP3_PIT_TURN_S = 4.8          # ... then turn about 120 degrees
 NP3_TILT_LIMIT_DEG = 25.0     # dangerous inclination (ISC measures -60..60 deg, 3.2.14)
