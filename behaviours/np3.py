@@ -234,7 +234,8 @@ class NP3(Runtime, Np3Skeleton):
         self.next_plan = now + T.NP3_EXPLORE_PLAN_S
         self.map.plan = []
         if self.cfg.task == "seek_light":          # searching for a light it cannot see: the nearest unknown
-            self.goal = self.route_to_frontier(x, y)   # first, round walls by the map (a lamp behind a wall)
+            # the widest opening onto the unknown first, round walls by the map (a lamp behind a wall)
+            self.goal = self.route_to_frontier(x, y, T.NP3_SEEK_FRONTIER_WEIGHT_M)
             if self.goal is not None:
                 self.layers.sense(goal=self.goal)
                 return
@@ -259,10 +260,12 @@ class NP3(Runtime, Np3Skeleton):
             self.goal = self.route_to_frontier(x, y)
         self.layers.sense(goal=self.goal)
 
-    def route_to_frontier(self, x: float, y: float) -> tuple[float, float] | None:
-        """seed 3.3.2: plan over the rebuilt topological map to the nearest frontier; its first waypoint."""
+    def route_to_frontier(self, x: float, y: float, size_weight: float = 0.0) -> tuple[float, float] | None:
+        """seed 3.3.2: plan over the rebuilt topological map to the nearest frontier (`size_weight`: m of path a
+        cell of frontier is worth, TopoMap.frontier); its first waypoint."""
         self.map.rebuild()
-        frontier = self.map.frontier(x, y, min_size=T.NP3_PLAN_MIN_FRONTIER, min_path_m=T.NP3_PLAN_MIN_PATH_M)
+        frontier = self.map.frontier(x, y, min_size=T.NP3_PLAN_MIN_FRONTIER, min_path_m=T.NP3_PLAN_MIN_PATH_M,
+                                     size_weight=size_weight)
         route = self.map.route((x, y), (frontier.x, frontier.y)) if frontier is not None else None
         while route and math.dist(route[0], (x, y)) < T.NP3_GOAL_REACHED_M:
             route.pop(0)

@@ -484,8 +484,8 @@ class TaskModule:
         if goal is not None and pose is not None and goal != self.reached:
             if math.hypot(goal[0] - pose[0], goal[1] - pose[1]) < self.t.goal_reached_m:
                 self.reached = goal
-            else:
-                return self._steer(pose, math.atan2(goal[1] - pose[1], goal[0] - pose[0]))
+            else:   # round what the echo memory shows across the way (seed 5.1.2), not into avoidance again
+                return self._steer(pose, self._detour(i, pose, math.atan2(goal[1] - pose[1], goal[0] - pose[0]), now))
         return self._wander(now)
 
     def _wall_follow(self, i: Mapping[str, Any], now: float) -> MovCmd:

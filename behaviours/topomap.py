@@ -370,11 +370,14 @@ class TopoMap:
                     seen += g.seen[j * g.nx + i]
         return seen / total if total else 0.0
 
-    def frontier(self, x: float, y: float, min_size: int = 5, min_path_m: float = 0.0) -> Frontier | None:
+    def frontier(self, x: float, y: float, min_size: int = 5, min_path_m: float = 0.0,
+                 size_weight: float = 0.0) -> Frontier | None:
         """The nearest (by free path) cluster of free cells bordering open unknown space; None when explored.
 
         Clusters smaller than `min_size` cells are gaps between diverging beams,
         not frontiers; cells nearer than `min_path_m` are where the robot already is.
+        With `size_weight` a cluster's path counts that many metres less per cell of its edge (a wide opening
+        onto unknown space is worth a longer walk than a sliver, the usual gain-minus-cost frontier choice).
         """
         g = self.grid
         start = g.cell(x, y)
@@ -416,7 +419,8 @@ class TopoMap:
                 continue
             target = min(cluster, key=lambda c: (dist[c], c))
             cand = Frontier(*g.centre(*target), size=len(cluster), path_m=dist[target])
-            if best is None or (cand.path_m, -cand.size) < (best.path_m, -best.size):
+            if best is None or (cand.path_m - size_weight * cand.size, -cand.size) < \
+                    (best.path_m - size_weight * best.size, -best.size):
                 best = cand
         return best
 

@@ -102,6 +102,8 @@ NP3_EXPLORE_TURN_S = 2.4      # ... turning this long
 NP3_GOAL_REACHED_M = 0.4      # a goal this close (dead reckoning) is reached
 NP3_PLAN_MIN_PATH_M = 1.5    # explore: a route over the map to the nearest frontier at least this far (3.3.2) ...
 NP3_PLAN_MIN_FRONTIER = 20    # ... of at least this many cells (smaller ones are gaps between sonar beams)
+NP3_SEEK_FRONTIER_WEIGHT_M = 0.1  # seeking a light no sample shows: a frontier cell is worth this much path (the
+                              # widest opening onto the unknown, where a lamp behind a wall is, before the nearest)
 NP3_HEADING_TOL_DEG = 20.0    # steering: turn on the spot while the goal is further off the axis than this
 NP3_LIGHT_SAMPLES = 8         # light gradient: plane fitted through this many (pose, log lux) samples
 NP3_LIGHT_MIN_SPREAD_M = 0.15 # ... spread at least this far in both directions for a first fit (one L); later

@@ -140,6 +140,23 @@ def test_frontier_points_into_unknown_space_and_vanishes_when_explored():
     assert m.frontier(11.0, 1.0) is None
 
 
+def test_frontier_size_weight_prefers_a_wide_opening_to_a_near_sliver():
+    # a free strip between two walls (pits), open at its near left end (a sliver) and widening into unknown
+    # space at its far right end: the nearest frontier is the sliver; weighted by size, the wide opening
+    g = OccupancyGrid(-1.0, -1.0, 8.0, 4.0, 0.1)
+    m = TopoMap(g)
+    for k in range(81):
+        g.mark_free(0.5 + 0.05 * k, 1.0, 0.3)
+    g.mark_free(4.5, 1.0, 0.8)
+    for k in range(69):
+        g.mark_barrier(0.2 + 0.05 * k, 0.6)
+        g.mark_barrier(0.2 + 0.05 * k, 1.4)
+    near = m.frontier(1.0, 1.0, min_size=3)
+    wide = m.frontier(1.0, 1.0, min_size=3, size_weight=0.1)
+    assert near is not None and near.x < 0.5
+    assert wide is not None and wide.x > 3.0 and wide.size > 5 * near.size and wide.path_m > near.path_m
+
+
 def test_png_has_the_grid_size_and_shows_walls_places_and_unknown(tmp_path, square_room):
     out = square_room.save_png(tmp_path / "map.png", px_per_cell=4)
     img = Image.open(out)
