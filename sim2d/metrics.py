@@ -201,7 +201,8 @@ def metrics_schema(spec: Any, measured: Sequence[str] = ()) -> dict[str, Any]:
                                                  "unchecked", "starved")},
                           "by_rule": {"type": "object", "additionalProperties": _VALUE},
                           **{k: _obj({b: _VALUE for b in spec.buses}) for k in ("max_wait_slots", "k_slots")},
-                          "checked": {"type": "object", "additionalProperties": _VALUE}}),
+                          "checked": {"type": "object", "additionalProperties": _VALUE},
+                          "skipped": {"type": "object", "additionalProperties": _TEXT}}),   # rule -> why not
         "reactions": {"type": "array"},         # one record per reaction (the report's sequence charts)
         "expectations": {"type": "array"},      # added by the runner to metrics.json
     })

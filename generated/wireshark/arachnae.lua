@@ -60,6 +60,11 @@ local NODES = {
   [0x2D] = "PSC",
 }
 
+-- seed 3.2.1: the messages a master may send to broadcast (spec messages.yaml `broadcast: true`)
+local MAY_BROADCAST = {
+  [0x01] = true,
+}
+
 local MESSAGE_NAMES = {
   [0x01] = "INIT",
   [0x02] = "ID_REQ",
@@ -256,6 +261,7 @@ local EXPERT = {
   TRUNCATED = ProtoExpert.new("arachnae.error.truncated", "TRUNCATED: fewer bytes than header+crc, or than header+length+crc", expert.group.MALFORMED, expert.severity.ERROR),
   OVERSIZE = ProtoExpert.new("arachnae.error.oversize", "OVERSIZE: more bytes than the length byte says, or than the parser's buffer holds", expert.group.MALFORMED, expert.severity.ERROR),
   CHECKSUM = ProtoExpert.new("arachnae.error.checksum", "CHECKSUM: CRC mismatch", expert.group.CHECKSUM, expert.severity.ERROR),
+  ROUTE = ProtoExpert.new("arachnae.error.route", "ROUTE: src is not a node, dst neither a node nor broadcast, or broadcast on a message the spec does not mark broadcast", expert.group.PROTOCOL, expert.severity.ERROR),
   OPCODE = ProtoExpert.new("arachnae.error.opcode", "OPCODE: unknown opcode (or one the role does not receive)", expert.group.PROTOCOL, expert.severity.ERROR),
   LENGTH = ProtoExpert.new("arachnae.error.length", "LENGTH: payload size not valid for the message, or an array count that disagrees with it", expert.group.MALFORMED, expert.severity.ERROR),
   RANGE = ProtoExpert.new("arachnae.error.range", "RANGE: a field outside its raw range, enum or flags mask, or not a node address", expert.group.PROTOCOL, expert.severity.ERROR),
@@ -1191,6 +1197,18 @@ function proto.dissector(tvb, pinfo, tree)
       crc_item:append_text(string.format(" [incorrect, should be 0x%04X]", want))
       t:add(hf.crc_status, tvb(HEADER_SIZE + length, CRC_SIZE), 0)
       fail("CHECKSUM", crc_item, string.format("checksum 0x%04X does not match, expected 0x%04X", got, want))
+    end
+    -- ROUTE (seed 3.2.1), as the codecs' frame check without an own address, in the same order
+    if dst == BROADCAST then
+      if not MAY_BROADCAST[opcode] then
+        fail("ROUTE", t, string.format("%s to broadcast 0x%02X, but the spec does not mark it broadcast",
+          MESSAGE_NAMES[opcode] or string.format("opcode 0x%02X", opcode), BROADCAST))
+      end
+    elseif NODES[dst] == nil then
+      fail("ROUTE", t, string.format("destination 0x%02X is not a node address", dst))
+    end
+    if NODES[src] == nil then
+      fail("ROUTE", t, string.format("source 0x%02X is not a node address", src))
     end
     local payload = tvb:range(HEADER_SIZE, length)
     local m = MESSAGES[opcode]

@@ -50,7 +50,7 @@ LEAVES = [(name, path) for name, doc in DOCS.items() for path in _leaves(doc)]
 TEXT_LEAVES = [(n, p) for n, p in LEAVES if p[-1] in ("doc", "unit", "long", "rule", "when") or "texts" in p
                or p == ("frame", "checksum", "name")]
 NAMES = sorted({m["name"] for m in DOCS[M]["messages"]} | {f["name"] for m in DOCS[M]["messages"] for f in m.get("fields", [])}
-               | set(DOCS[M]["enums"]) | set(DOCS[M]["flags"]) | {k for e in DOCS[M]["enums"].values() for k in e["values"]}
+               | set(DOCS[M]["enums"]) | set(DOCS[M]["flags"]) | {k for e in DOCS[M]["enums"].values() for k in e.get("values", e.get("names", []))}
                | {n["role"] for n in DOCS[N]["nodes"]} | {n["short"] for n in DOCS[N]["nodes"]} | set(DOCS[N]["buses"]))
 
 

@@ -3,7 +3,7 @@
 It registers for the spec's user link type (frame.pcap_linktype), decodes the
 header (node names), the message and every field (enum names, physical values
 with units), checks the CRC and reports each failed check the codecs make
-(TRUNCATED, OVERSIZE, CHECKSUM, OPCODE, LENGTH, RANGE) as expert-info errors.
+(TRUNCATED, OVERSIZE, CHECKSUM, ROUTE, OPCODE, LENGTH, RANGE) as expert-info errors.
 The field walk is table-driven from codegen.layout, shared with the sigrok decoder.
 """
 from __future__ import annotations
@@ -25,8 +25,8 @@ _PROTOFIELD = {(False, 8): "uint8", (True, 8): "int8", (False, 16): "uint16", (T
 
 # The codecs' checks a passive reader can make (ADDRESS needs an own address, BUFFER a caller's buffer),
 # with the expert-info group each failure belongs to.
-EXPERT_GROUPS = {"TRUNCATED": "MALFORMED", "OVERSIZE": "MALFORMED", "CHECKSUM": "CHECKSUM", "OPCODE": "PROTOCOL",
-                 "LENGTH": "MALFORMED", "RANGE": "PROTOCOL"}
+EXPERT_GROUPS = {"TRUNCATED": "MALFORMED", "OVERSIZE": "MALFORMED", "CHECKSUM": "CHECKSUM", "ROUTE": "PROTOCOL",
+                 "OPCODE": "PROTOCOL", "LENGTH": "MALFORMED", "RANGE": "PROTOCOL"}
 
 
 def protofield(bits: int, signed: bool) -> str:
