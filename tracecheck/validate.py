@@ -599,12 +599,22 @@ class Validator:
         for j in relays + [None]:
             f = frames[j] if j is not None else None
             if run and f is not None and self._same_move(frames[run[-1]], f) and not any(
-                    g.name in records and g.intact for g in frames[run[-1] + 1:j]):
+                    self._new_command(g, records, f.parsed.message.address) for g in frames[run[-1] + 1:j]):
                 run.append(j)
             else:
                 if run:
                     self._check_move_run(frames, run)
                 run = [j] if j is not None else []
+
+    def _new_command(self, g: TraceFrame, records: set[str], address: int) -> bool:
+        """`g` starts a new command of `address`: a record carrying one (MOVE), or, for a reflex the MCP relays
+        itself (seed 5.2, spec reflexes), a new record from the reflex's source, e.g. a second whisker touching."""
+        if not g.intact:
+            return False
+        if g.name in records:
+            return True
+        return (g.name in self.rules.targeted and self.dst(g) == self.rules.mcp
+                and g.parsed.message.source == address)
 
     @staticmethod
     def _same_move(a: TraceFrame, b: TraceFrame) -> bool:

@@ -158,6 +158,38 @@ def test_a_move_relayed_resent_after_a_corrupt_echo_is_no_violation(saved, tmp_p
     assert ("move_retries" in out["by_rule"]) is not corrupt, out
 
 
+@pytest.mark.parametrize("new_record", [True, False])
+def test_a_reflex_relayed_again_after_a_new_record_is_no_resend(saved, tmp_path, new_record):
+    """Two whisker records in a row (seed 5.2) each make the MCP relay STOP to the MMC: the second MOVE_RELAYED
+    follows a new record from the reflex source, so it is a new command, not a resend (a run of
+    fault_us_killed_explore, seed 47, was flagged). Without the record between them it is a resend."""
+    from arachnae_proto import frame
+    from arachnae_proto import messages as M
+    from arachnae_proto.enums import MovCmd, RecordKind
+    from arachnae_proto.network import ADDRESS_OF
+
+    table = rows(saved / "trace.tsv")
+    i = next(i for i, r in enumerate(table[1:], 1) if r[2] == "first" and r[6].startswith("MOVE_RELAYED"))
+    start, end = float(table[i][0]), float(table[i][1])
+    mcp, mmc, spu, np3, tpsc = (ADDRESS_OF[n] for n in ("MCP", "MMC", "SPU", "NP3", "TPSC"))
+
+    def row(t0: float, t1: float, src: str, dst: str, data: bytes, text: str) -> list[str]:
+        r = list(table[i])
+        r[0], r[1], r[3], r[4], r[5], r[6] = f"{t0:.6f}", f"{t1:.6f}", src, src, dst, text
+        r[7] = r[-1] = data.hex()
+        return r
+
+    stop = frame.build(mmc, mcp, M.MoveRelayed(address=tpsc, mov_cmd=int(MovCmd.STOP), param=0))
+    record = frame.build(mcp, spu, M.XmitRecord(target=np3, source=tpsc, kind=int(RecordKind.VALUE), channel=0, value=64))
+    added = [row(end + 0.001, end + 0.009, "MCP", "MMC", stop, "MOVE_RELAYED")]
+    if new_record:
+        added.append(row(end + 0.010, end + 0.022, "SPU", "MCP", record, "XMIT_RECORD"))
+    added.append(row(end + 0.023, end + 0.031, "MCP", "MMC", stop, "MOVE_RELAYED"))
+    table[i + 1:i + 1] = added
+    out = check_table(table)
+    assert ("move_retries" in out) is not new_record, out.get("move_retries")
+
+
 def test_a_request_raised_during_post_is_counted_from_its_init(tmp_path):
     """A key typed on the RCP during the POST (seed 6.3) waits for the INIT that ends it: the masters serve no
     request while they identify their nodes, and the K bound is the model of the running network. Counted
