@@ -21,6 +21,7 @@ from typing import Any
 import jinja2
 
 from arachnae.errors import UserError
+from arachnae.files import ours
 from codegen.model import Spec
 
 REPO = Path(__file__).resolve().parent.parent
@@ -90,12 +91,8 @@ def _under(out: Path, rel: Path) -> Path:
 
 
 def _is_generated(path: Path) -> bool:
-    """A file this generator wrote (so it may remove it when the spec no longer produces it)."""
-    try:
-        with path.open("rb") as fh:
-            return MARKER in fh.readline()
-    except OSError:
-        return False
+    """A file this generator wrote (so it may replace it, or remove it when the spec no longer produces it)."""
+    return ours(path, MARKER.decode())
 
 
 def _leftovers(files: dict[Path, bytes], out: Path, languages: tuple[str, ...]) -> list[Path]:
