@@ -263,5 +263,5 @@ def cmd_sweep_report(args: argparse.Namespace) -> int:
 
     md = write_report(Path(args.results))
     print(md.read_text(), end="")
-    print(f"report {md}")
+    print(f"report {md} and {md.with_suffix('.html')}")
     return 0

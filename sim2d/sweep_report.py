@@ -1,16 +1,23 @@
 """`arachnae sweep report RESULTS` (issue 14): how often a sweep's expectations hold, and what predicts failure.
 
 Pass rate per expectation with a Wilson 95 % interval (sound at small counts and at 0 % / 100 %, where the
-normal approximation collapses); failure rate per parameter bin; the worst runs with their replay
-command; PNG bar charts (Pillow, already a dependency) and report.md in the results folder.
+normal approximation collapses); failure rate per parameter bin; the spread of each collected metric per
+scenario (what a builder sets an expectation from: issue 16 item 7); the worst runs with their replay command.
+Written as report.md and as report.html (the run report's page style, plots inlined, each worst run linked to
+its own run report in failed/RUN/), with PNG bar charts (Pillow, already a dependency) in plots/.
 """
 from __future__ import annotations
 
 import math
+import statistics
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from arachnae.files import atomic_open
+from codegen.html import write_page
+from sim2d.report import TEMPLATES, data_uri
 from sim2d.sweep import read_table
 
 Z95 = 1.959963984540054          # two-sided 95 % quantile of the normal distribution
@@ -31,6 +38,21 @@ class Rate:
     @property
     def interval(self) -> tuple[float, float]:
         return wilson(self.k, self.n)
+
+    @property
+    def text(self) -> str:
+        """`50.0 % [15.0, 85.0]`: the rate and its Wilson 95 % interval, in percent."""
+        lo, hi = self.interval
+        return f"{100 * self.rate:.1f} % [{100 * lo:.1f}, {100 * hi:.1f}]"
+
+
+@dataclass(frozen=True)
+class ParamRates:
+    """The failure rates per bin of one varied parameter, with its chart as a data: URI for the page."""
+
+    name: str
+    rates: list[Rate]
+    plot: str | None
 
 
 def wilson(k: int, n: int, z: float = Z95) -> tuple[float, float]:
@@ -85,11 +107,66 @@ def failure_by_parameter(rows: list[dict[str, Any]]) -> dict[str, list[Rate]]:
     return out
 
 
+@dataclass(frozen=True)
+class Spread:
+    """One collected metric over one scenario's runs: numbers as min / median / max, flags and words as counts."""
+
+    scenario: str
+    metric: str
+    n: int                       # runs that gave a value
+    text: str
+
+
+def _spread_text(values: list[Any]) -> str:
+    """`0.41 / 0.52 / 0.9` for numbers, `3 of 20` for flags, `NORMAL 18, DEGRADED 2` for anything else."""
+    if all(isinstance(v, bool) for v in values):
+        return f"{sum(values)} of {len(values)}"
+    if all(isinstance(v, (int, float)) for v in values):
+        return " / ".join(f"{round(float(x), 3):g}" for x in (min(values), statistics.median(values), max(values)))
+    return ", ".join(f"{v} {k}" for v, k in Counter(map(str, values)).most_common())
+
+
+def metric_spread(rows: list[dict[str, Any]]) -> list[Spread]:
+    """Per base scenario and collected metric, the spread of the values the runs gave (runs with none are left out)."""
+    metrics = [k for k in (rows[0] if rows else {}) if k.startswith("metric.")]
+    out = []
+    for scenario in sorted({r["scenario"] for r in rows}):
+        mine = [r for r in rows if r["scenario"] == scenario]
+        for col in metrics:
+            values = [r[col] for r in mine if r[col] is not None]
+            if values:
+                out.append(Spread(scenario, col.removeprefix("metric."), len(values), _spread_text(values)))
+    return out
+
+
+@dataclass(frozen=True)
+class WorstRun:
+    """A failing run as the report lists it: what failed, how to replay it, and its own run report if kept."""
+
+    run_id: str
+    scenario: str
+    seed: int
+    params: str
+    failed: str
+    replay: str
+    report: str | None           # failed/RUN/report.html, relative to the results folder
+
+
 def worst_runs(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """Failing runs, most expectations failed first (errors first of all), then by run id."""
     failing = [r for r in rows if not r["passed"]]
     return sorted(failing, key=lambda r: (r["error"] is None, -len((r["failed"] or "").split(", ")),
                                           r["run_id"]))[:WORST]
+
+
+def _worst(results: Path, rows: list[dict[str, Any]]) -> list[WorstRun]:
+    out = []
+    for r in worst_runs(rows):
+        page = Path("failed") / r["run_id"] / "report.html"
+        out.append(WorstRun(r["run_id"], r["scenario"], r["seed"],
+                            ", ".join(f"{k.removeprefix('param.')}={v}" for k, v in r.items() if k.startswith("param.")),
+                            r["error"] or r["failed"], r["replay"], str(page) if (results / page).is_file() else None))
+    return out
 
 
 def bar_chart(title: str, rates: list[Rate], path: Path, what: str) -> None:
@@ -116,37 +193,48 @@ def bar_chart(title: str, rates: list[Rate], path: Path, what: str) -> None:
     img.save(path)
 
 
-def _pct(r: Rate) -> str:
-    lo, hi = r.interval
-    return f"{100 * r.rate:.1f} % [{100 * lo:.1f}, {100 * hi:.1f}]"
+def _md_table(head: list[str], rows: list[list[Any]]) -> list[str]:
+    """A markdown table; the first column left-aligned, the others right-aligned."""
+    out = ["| " + " | ".join(head) + " |", "|---|" + "---:|" * (len(head) - 1)]
+    return out + ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
 
 
 def write_report(results: Path) -> Path:
-    """report.md and plots/*.png in the results folder; returns report.md's path."""
+    """report.md, report.html and plots/*.png in the results folder; returns report.md's path."""
     rows = read_table(results)
     plots = results / "plots"
     plots.mkdir(exist_ok=True)
     passes = pass_rates(rows)
     bar_chart("pass rate per expectation", passes, plots / "pass_rates.png", "pass")
-    lines = [f"# Sweep report: {results}", "", f"{len(rows)} runs, {sum(bool(r['passed']) for r in rows)} passed.", "",
-             "## Pass rate per expectation (Wilson 95 % interval)", "", "| expectation | runs | passed | rate [95 % CI] |",
-             "|---|---:|---:|---|"]
-    lines += [f"| {r.label} | {r.n} | {r.k} | {_pct(r)} |" for r in passes]
+    by_param = failure_by_parameter(rows)
+    for param, rates in by_param.items():
+        bar_chart(f"failure rate per {param}", rates, plots / f"fail_{param}.png", "failure")
+    spreads = metric_spread(rows)
+    worst = _worst(results, rows)
+    passed = sum(bool(r["passed"]) for r in rows)
+
+    lines = [f"# Sweep report: {results}", "", f"{len(rows)} runs, {passed} passed.", "",
+             "## Pass rate per expectation (Wilson 95 % interval)", ""]
+    lines += _md_table(["expectation", "runs", "passed", "rate [95 % CI]"], [[r.label, r.n, r.k, r.text] for r in passes])
     lines += ["", "![pass rates](plots/pass_rates.png)", "", "## Failure rate per parameter bin", ""]
-    for param, rates in failure_by_parameter(rows).items():
-        png = f"fail_{param}.png"
-        bar_chart(f"failure rate per {param}", rates, plots / png, "failure")
-        lines += [f"### {param}", "", "| bin | runs | failed | failure rate [95 % CI] |", "|---|---:|---:|---|"]
-        lines += [f"| {r.label} | {r.n} | {r.k} | {_pct(r)} |" for r in rates]
-        lines += ["", f"![failure rate per {param}](plots/{png})", ""]
-    lines += ["## Worst runs", ""]
-    worst = worst_runs(rows)
+    for param, rates in by_param.items():
+        lines += [f"### {param}", ""]
+        lines += _md_table(["bin", "runs", "failed", "failure rate [95 % CI]"], [[r.label, r.n, r.k, r.text] for r in rates])
+        lines += ["", f"![failure rate per {param}](plots/fail_{param}.png)", ""]
+    lines += ["## Metrics per scenario (min / median / max)", ""]
+    lines += _md_table(["scenario", "metric", "runs", "spread"], [[s.scenario, s.metric, s.n, s.text] for s in spreads])
+    lines += ["", "## Worst runs", ""]
     if not worst:
         lines.append("No run failed.")
-    for r in worst:
-        params = ", ".join(f"{k.removeprefix('param.')}={v}" for k, v in r.items() if k.startswith("param."))
-        lines += [f"- {r['run_id']} ({r['scenario']}, seed {r['seed']}{', ' + params if params else ''}): "
-                  f"failed {r['error'] or r['failed']}", f"  `{r['replay']}`"]
+    for w in worst:
+        lines += [f"- {w.run_id} ({w.scenario}, seed {w.seed}{', ' + w.params if w.params else ''}): failed {w.failed}",
+                  f"  `{w.replay}`" + (f" (run report: {w.report})" if w.report else "")]
     md = results / "report.md"
-    md.write_text("\n".join(lines) + "\n")
+    with atomic_open(md) as fh:                     # a report is whole or absent, never half-written
+        fh.write("\n".join(lines) + "\n")
+    write_page(results / "report.html", "sweep_report.html.j2",
+               {"results": results, "runs": len(rows), "passed": passed, "passes": passes,
+                "pass_plot": data_uri(plots / "pass_rates.png"), "spreads": spreads, "worst": worst,
+                "params": [ParamRates(p, rates, data_uri(plots / f"fail_{p}.png")) for p, rates in by_param.items()]},
+               extra_dirs=[TEMPLATES])
     return md

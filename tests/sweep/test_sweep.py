@@ -109,6 +109,26 @@ def test_report(two_workers: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert f"arachnae sim run {two_workers / 'scenarios' / 'r000000.yaml'} --seed 1" in md
     for png in ("pass_rates.png", "fail_fault_node.png"):
         assert (two_workers / "plots" / png).read_bytes().startswith(b"\x89PNG")
+    # the spread a builder sets expectations from: every run gave a distance, and a verdict word is counted
+    rows = {r["run_id"]: r for r in pq.read_table(two_workers / "results.parquet").to_pylist()}
+    walked = sorted(r["metric.distance_walked_m"] for r in rows.values())
+    spread = f"{round(walked[0], 3):g} / {round((walked[1] + walked[2]) / 2, 3):g} / {round(walked[-1], 3):g}"
+    assert f"| tiny.yaml | distance_walked_m | 4 | {spread} |" in md, md
+    assert "| tiny.yaml | post.verdict | 4 | OPERATIONAL 4 |" in md
+
+
+def test_report_page_links_each_failing_run_to_its_own_report(two_workers: Path) -> None:
+    """report.html (issue 14 item 3, with the run reports of issue 13): the plots inline, the worst runs linked."""
+    assert main(["sweep", "report", str(two_workers)]) == 0
+    page = (two_workers / "report.html").read_text()
+    charts = sorted(p.name for p in (two_workers / "plots").glob("*.png"))
+    assert charts == ["fail_fault_at.png", "fail_fault_node.png", "fail_scenario.png", "pass_rates.png"]
+    assert '<meta name="generator" content="arachnae">' in page and page.count("data:image/png;base64,") == len(charts)
+    failing = [r["run_id"] for r in pq.read_table(two_workers / "results.parquet").to_pylist() if not r["passed"]]
+    assert failing
+    for run_id in failing:
+        assert f'<a href="failed/{run_id}/report.html">{run_id}</a>' in page
+        assert (two_workers / "failed" / run_id / "report.html").is_file()
 
 
 def test_wilson_known_values() -> None:
