@@ -461,33 +461,12 @@ static inline void arachnae_frame_header(const uint8_t *frame, arachnae_header *
 /* The payload is already at frame + ARACHNAE_FRAME_PAYLOAD: write header and CRC. */
 arachnae_status arachnae_frame_finish(uint8_t *frame, uint16_t cap, uint8_t dst, uint8_t src, uint8_t opcode,
                                       uint8_t payload_len, uint16_t *frame_len);
-/* Writes header and CRC around the payload_len bytes at frame + ARACHNAE_FRAME_PAYLOAD, sets
- * *frame_len, returns OK; the caller checked that ARACHNAE_FRAME_OVERHEAD + payload_len bytes fit.
- * (Argument order as the generated _build functions', so that they end in a jump here.) */
-arachnae_status arachnae_frame_seal(uint8_t opcode, uint8_t dst, uint8_t src, uint8_t *frame, uint8_t payload_len,
-                                    uint16_t *frame_len);
+/* Writes dst, src and the CRC around the opcode, length byte and payload the caller put in the frame, sets
+ * *frame_len, returns OK; the caller checked that ARACHNAE_FRAME_OVERHEAD + length bytes fit. Four
+ * arguments: on an 8-bit core all in call-clobbered registers, so no caller saves any (issue 15). */
+arachnae_status arachnae_frame_seal(uint8_t *frame, uint8_t dst, uint8_t src, uint16_t *frame_len);
 /* Envelope check: TRUNCATED/OVERSIZE, CHECKSUM, ADDRESS (own = ARACHNAE_ANY_ADDRESS skips it), then ROUTE. */
 arachnae_status arachnae_frame_check(const uint8_t *frame, uint16_t len, uint16_t own);
-
-/* Frames a node checked but delivered to no callback (issue 10: never dropped silently): how many
- * (saturating at 0xFFFF), and the opcode and status of the last one. Lives in the caller's node state. */
-typedef struct {
-    uint16_t count;
-    uint8_t opcode;
-    uint8_t status;
-} arachnae_unhandled;
-
-/* Records `st` for `opcode` when it is not OK; returns st. */
-static inline arachnae_status arachnae_unhandled_note(arachnae_unhandled *u, uint8_t opcode, arachnae_status st)
-{
-    if (st != ARACHNAE_OK) {
-        if (u->count != 0xFFFFu)
-            u->count++;
-        u->opcode = opcode;
-        u->status = (uint8_t)st;
-    }
-    return st;
-}
 
 /* ---- byte-at-a-time parser (UART RX interrupt) ----
  * feed() returns ARACHNAE_NONE while a frame is incomplete, ARACHNAE_OK when a
@@ -514,10 +493,21 @@ typedef struct {
 
 void arachnae_parser_init(arachnae_parser *p, uint8_t *buf, uint16_t cap, uint16_t own,
                           arachnae_payload_check_fn check);
+/* The same as a static initializer, for a parser whose buffer, own address and check are known at build
+ * time: no code at all (issue 15), e.g. static arachnae_parser p = ARACHNAE_PARSER_INIT(buf, sizeof buf, own, check); */
+#define ARACHNAE_PARSER_INIT(buf, cap, own, check) { (buf), (cap), 0u, (own), 0u, (check) }
 arachnae_status arachnae_parser_feed(arachnae_parser *p, uint8_t byte);
 arachnae_status arachnae_parser_gap(arachnae_parser *p);
-/* The last complete and valid frame (NULL if none since the last gap). */
-const uint8_t *arachnae_parser_frame(const arachnae_parser *p, uint16_t *len);
+/* The last complete and valid frame (NULL if none since the last gap). Inline: a field read, not
+ * worth a call (issue 15). READY and HELD, the parser's two states with a valid frame, are the highest. */
+#define ARACHNAE_PARSER_READY 3u
+static inline const uint8_t *arachnae_parser_frame(const arachnae_parser *p, uint16_t *len)
+{
+    if (p->state < ARACHNAE_PARSER_READY)
+        return 0;
+    *len = p->count;
+    return p->buf;
+}
 
 /* ---- messages ----
  * For each message X:

@@ -11,9 +11,6 @@ arachnae_status mcp_node_init(mcp_node *node, uint8_t address, void *user)
         return ARACHNAE_ADDRESS;
     node->address = address;
     node->user = user;
-    node->unhandled.count = 0;
-    node->unhandled.opcode = 0;
-    node->unhandled.status = ARACHNAE_OK;
     return ARACHNAE_OK;
 }
 
@@ -40,11 +37,15 @@ arachnae_status mcp_payload_check(uint8_t opcode, const uint8_t *payload, uint8_
     }
 }
 
-/* A frame for us whose payload passed mcp_payload_check: call its callback, or
- * build and send the reply to a request (one reply buffer, one seal and one send for all of them:
- * each reply is checked and packed, never built through its _build, issue 15). */
-static arachnae_status deliver(mcp_node *node, const arachnae_header *h, const uint8_t *payload)
+/* A frame the parser passed with own = node->address and mcp_payload_check (feed() said OK):
+ * envelope and payload are checked once, there, not again here (issue 15). Calls its callback, or
+ * builds and sends the reply to a request (one reply buffer, one seal and one send for all of them:
+ * each reply is checked and packed, never built through its _build). */
+arachnae_status mcp_dispatch(mcp_node *node, const uint8_t *frame)
 {
+    arachnae_header *h = &node->rx;
+    const uint8_t *payload = frame + ARACHNAE_FRAME_PAYLOAD;
+    arachnae_frame_header(frame, h);
     switch (h->opcode) {
     case ARACHNAE_OP_ID_ACK:
         arachnae_id_ack_unpack(payload, h->length, &node->msg.rx_id_ack);
@@ -76,19 +77,7 @@ static arachnae_status deliver(mcp_node *node, const arachnae_header *h, const u
         arachnae_move_unpack(payload, h->length, &node->msg.rx_move);
         mcp_on_move(node, h, &node->msg.rx_move);
         return ARACHNAE_OK;
-    default:
-        return ARACHNAE_OK;
+    default:   /* not reached: the payload check refused every other opcode */
+        return ARACHNAE_OPCODE;
     }
-}
-
-arachnae_status mcp_dispatch(mcp_node *node, const uint8_t *frame, uint16_t len)
-{
-    arachnae_status st = arachnae_frame_check(frame, len, node->address);
-    if (st != ARACHNAE_OK)
-        return st;
-    arachnae_frame_header(frame, &node->rx);
-    st = mcp_payload_check(node->rx.opcode, frame + ARACHNAE_FRAME_PAYLOAD, node->rx.length);
-    if (st == ARACHNAE_OK)
-        st = deliver(node, &node->rx, frame + ARACHNAE_FRAME_PAYLOAD);
-    return arachnae_unhandled_note(&node->unhandled, node->rx.opcode, st);
 }
