@@ -534,7 +534,7 @@ typedef struct {
 
 arachnae_status arachnae_id_ack_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_id_ack_decode(const uint8_t *payload, uint8_t len, arachnae_id_ack_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_id_ack_unpack(const uint8_t *payload, uint8_t len, arachnae_id_ack_t *out);
 arachnae_status arachnae_id_ack_check(const arachnae_id_ack_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -555,7 +555,7 @@ typedef struct {
 
 arachnae_status arachnae_status_ack_busy_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_status_ack_busy_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_busy_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_status_ack_busy_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_busy_t *out);
 arachnae_status arachnae_status_ack_busy_check(const arachnae_status_ack_busy_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -572,7 +572,7 @@ typedef struct {
 
 arachnae_status arachnae_status_ack_order_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_status_ack_order_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_order_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_status_ack_order_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_order_t *out);
 arachnae_status arachnae_status_ack_order_check(const arachnae_status_ack_order_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -589,7 +589,7 @@ typedef struct {
 
 arachnae_status arachnae_status_ack_range_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_status_ack_range_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_range_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_status_ack_range_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_range_t *out);
 arachnae_status arachnae_status_ack_range_check(const arachnae_status_ack_range_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -609,7 +609,7 @@ typedef struct {
 
 arachnae_status arachnae_status_ack_mmc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_status_ack_mmc_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_mmc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_status_ack_mmc_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_mmc_t *out);
 arachnae_status arachnae_status_ack_mmc_check(const arachnae_status_ack_mmc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -631,7 +631,7 @@ typedef struct {
 
 arachnae_status arachnae_post_report_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_post_report_decode(const uint8_t *payload, uint8_t len, arachnae_post_report_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_post_report_unpack(const uint8_t *payload, uint8_t len, arachnae_post_report_t *out);
 arachnae_status arachnae_post_report_check(const arachnae_post_report_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -664,7 +664,7 @@ typedef struct {
 
 arachnae_status arachnae_xmit_record_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_record_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_record_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_xmit_record_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_record_t *out);
 arachnae_status arachnae_xmit_record_check(const arachnae_xmit_record_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -684,7 +684,7 @@ typedef struct {
 
 arachnae_status arachnae_data_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_data_decode(const uint8_t *payload, uint8_t len, arachnae_data_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_data_unpack(const uint8_t *payload, uint8_t len, arachnae_data_t *out);
 arachnae_status arachnae_data_check(const arachnae_data_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -702,7 +702,7 @@ typedef struct {
 
 arachnae_status arachnae_move_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_move_decode(const uint8_t *payload, uint8_t len, arachnae_move_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_move_unpack(const uint8_t *payload, uint8_t len, arachnae_move_t *out);
 arachnae_status arachnae_move_check(const arachnae_move_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -721,7 +721,7 @@ typedef struct {
 
 arachnae_status arachnae_move_relayed_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_move_relayed_decode(const uint8_t *payload, uint8_t len, arachnae_move_relayed_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_move_relayed_unpack(const uint8_t *payload, uint8_t len, arachnae_move_relayed_t *out);
 arachnae_status arachnae_move_relayed_check(const arachnae_move_relayed_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -742,7 +742,7 @@ typedef struct {
 
 arachnae_status arachnae_setup_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_setup_decode(const uint8_t *payload, uint8_t len, arachnae_setup_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_setup_unpack(const uint8_t *payload, uint8_t len, arachnae_setup_t *out);
 arachnae_status arachnae_setup_check(const arachnae_setup_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -761,7 +761,7 @@ typedef struct {
 
 arachnae_status arachnae_speak_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_speak_decode(const uint8_t *payload, uint8_t len, arachnae_speak_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_speak_unpack(const uint8_t *payload, uint8_t len, arachnae_speak_t *out);
 arachnae_status arachnae_speak_check(const arachnae_speak_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -780,7 +780,7 @@ typedef struct {
 
 arachnae_status arachnae_speak_resident_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_speak_resident_decode(const uint8_t *payload, uint8_t len, arachnae_speak_resident_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_speak_resident_unpack(const uint8_t *payload, uint8_t len, arachnae_speak_resident_t *out);
 arachnae_status arachnae_speak_resident_check(const arachnae_speak_resident_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -799,7 +799,7 @@ typedef struct {
 
 arachnae_status arachnae_lcd_text_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_lcd_text_decode(const uint8_t *payload, uint8_t len, arachnae_lcd_text_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_lcd_text_unpack(const uint8_t *payload, uint8_t len, arachnae_lcd_text_t *out);
 arachnae_status arachnae_lcd_text_check(const arachnae_lcd_text_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -816,7 +816,7 @@ typedef struct {
 
 arachnae_status arachnae_uic_alert_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_uic_alert_decode(const uint8_t *payload, uint8_t len, arachnae_uic_alert_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_uic_alert_unpack(const uint8_t *payload, uint8_t len, arachnae_uic_alert_t *out);
 arachnae_status arachnae_uic_alert_check(const arachnae_uic_alert_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -833,7 +833,7 @@ typedef struct {
 
 arachnae_status arachnae_head_set_abs_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_head_set_abs_decode(const uint8_t *payload, uint8_t len, arachnae_head_set_abs_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_head_set_abs_unpack(const uint8_t *payload, uint8_t len, arachnae_head_set_abs_t *out);
 arachnae_status arachnae_head_set_abs_check(const arachnae_head_set_abs_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -850,7 +850,7 @@ typedef struct {
 
 arachnae_status arachnae_head_set_rel_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_head_set_rel_decode(const uint8_t *payload, uint8_t len, arachnae_head_set_rel_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_head_set_rel_unpack(const uint8_t *payload, uint8_t len, arachnae_head_set_rel_t *out);
 arachnae_status arachnae_head_set_rel_check(const arachnae_head_set_rel_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -900,7 +900,7 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_usrc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_usrc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_usrc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_xmit_data_usrc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_usrc_t *out);
 arachnae_status arachnae_xmit_data_usrc_check(const arachnae_xmit_data_usrc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -920,7 +920,7 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_tpsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_tpsc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_tpsc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_xmit_data_tpsc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_tpsc_t *out);
 arachnae_status arachnae_xmit_data_tpsc_check(const arachnae_xmit_data_tpsc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -939,7 +939,7 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_irrc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_irrc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_irrc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_xmit_data_irrc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_irrc_t *out);
 arachnae_status arachnae_xmit_data_irrc_check(const arachnae_xmit_data_irrc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -966,7 +966,7 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_isc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_isc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_isc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_xmit_data_isc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_isc_t *out);
 arachnae_status arachnae_xmit_data_isc_check(const arachnae_xmit_data_isc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -984,7 +984,7 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_tsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_tsc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_tsc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_xmit_data_tsc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_tsc_t *out);
 arachnae_status arachnae_xmit_data_tsc_check(const arachnae_xmit_data_tsc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1001,7 +1001,7 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_lsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_lsc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_lsc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_xmit_data_lsc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_lsc_t *out);
 arachnae_status arachnae_xmit_data_lsc_check(const arachnae_xmit_data_lsc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1021,7 +1021,7 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_psc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_psc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_psc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_xmit_data_psc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_psc_t *out);
 arachnae_status arachnae_xmit_data_psc_check(const arachnae_xmit_data_psc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1041,7 +1041,7 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_irrc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_irrc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_irrc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_set_alarm_irrc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_irrc_t *out);
 arachnae_status arachnae_set_alarm_irrc_check(const arachnae_set_alarm_irrc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1062,7 +1062,7 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_isc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_isc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_isc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_set_alarm_isc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_isc_t *out);
 arachnae_status arachnae_set_alarm_isc_check(const arachnae_set_alarm_isc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1080,7 +1080,7 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_tsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_tsc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_tsc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_set_alarm_tsc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_tsc_t *out);
 arachnae_status arachnae_set_alarm_tsc_check(const arachnae_set_alarm_tsc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1097,7 +1097,7 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_lsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_lsc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_lsc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_set_alarm_lsc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_lsc_t *out);
 arachnae_status arachnae_set_alarm_lsc_check(const arachnae_set_alarm_lsc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1117,7 +1117,7 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_psc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_psc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_psc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_set_alarm_psc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_psc_t *out);
 arachnae_status arachnae_set_alarm_psc_check(const arachnae_set_alarm_psc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1141,7 +1141,7 @@ typedef struct {
 
 arachnae_status arachnae_leg_target_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_leg_target_decode(const uint8_t *payload, uint8_t len, arachnae_leg_target_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_leg_target_unpack(const uint8_t *payload, uint8_t len, arachnae_leg_target_t *out);
 arachnae_status arachnae_leg_target_check(const arachnae_leg_target_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1175,7 +1175,7 @@ typedef struct {
 
 arachnae_status arachnae_leg_report_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_leg_report_decode(const uint8_t *payload, uint8_t len, arachnae_leg_report_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_leg_report_unpack(const uint8_t *payload, uint8_t len, arachnae_leg_report_t *out);
 arachnae_status arachnae_leg_report_check(const arachnae_leg_report_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1202,7 +1202,7 @@ typedef struct {
 
 arachnae_status arachnae_joint_target_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_joint_target_decode(const uint8_t *payload, uint8_t len, arachnae_joint_target_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_joint_target_unpack(const uint8_t *payload, uint8_t len, arachnae_joint_target_t *out);
 arachnae_status arachnae_joint_target_check(const arachnae_joint_target_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1233,7 +1233,7 @@ typedef struct {
 
 arachnae_status arachnae_joint_feedback_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_joint_feedback_decode(const uint8_t *payload, uint8_t len, arachnae_joint_feedback_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_joint_feedback_unpack(const uint8_t *payload, uint8_t len, arachnae_joint_feedback_t *out);
 arachnae_status arachnae_joint_feedback_check(const arachnae_joint_feedback_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that

@@ -61,10 +61,13 @@ arachnae_status jac_dispatch(jac_node *node, const uint8_t *frame)
         op = ARACHNAE_OP_STATUS_ACK_ORDER;
         n = arachnae_status_ack_order_pack(&node->msg.reply_status, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
-    case ARACHNAE_OP_JOINT_TARGET:
-        arachnae_joint_target_unpack(payload, h->length, &node->msg.rx_joint_target);
+    case ARACHNAE_OP_JOINT_TARGET: {
+        /* arachnae_joint_target_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_joint_target.angle = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[0] << 8) | (unsigned)payload[1]), 0x8000u, 0xFFFFu);
+        node->msg.rx_joint_target.speed = (uint16_t)(((unsigned)payload[2] << 8) | (unsigned)payload[3]);
         jac_on_joint_target(node, h, &node->msg.rx_joint_target);
         return ARACHNAE_OK;
+    }
     case ARACHNAE_OP_JOINT_POLL:
         jac_on_joint_poll(node, h);
         return ARACHNAE_OK;

@@ -68,28 +68,44 @@ arachnae_status lcp_dispatch(lcp_node *node, const uint8_t *frame)
         op = ARACHNAE_OP_STATUS_ACK_ORDER;
         n = arachnae_status_ack_order_pack(&node->msg.reply_status, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
-    case ARACHNAE_OP_ID_ACK:
-        arachnae_id_ack_unpack(payload, h->length, &node->msg.rx_id_ack);
+    case ARACHNAE_OP_ID_ACK: {
+        /* arachnae_id_ack_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_id_ack.address = (uint8_t)((unsigned)payload[0]);
         lcp_on_id_ack(node, h, &node->msg.rx_id_ack);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_STATUS_ACK_ORDER:
-        arachnae_status_ack_order_unpack(payload, h->length, &node->msg.rx_status_ack_order);
+    }
+    case ARACHNAE_OP_STATUS_ACK_ORDER: {
+        /* arachnae_status_ack_order_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_status_ack_order.status = (uint8_t)((unsigned)payload[0]);
         lcp_on_status_ack_order(node, h, &node->msg.rx_status_ack_order);
         return ARACHNAE_OK;
+    }
     case ARACHNAE_OP_POST_QUERY:
         lcp_on_post_query(node, h);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_LEG_TARGET:
-        arachnae_leg_target_unpack(payload, h->length, &node->msg.rx_leg_target);
+    case ARACHNAE_OP_LEG_TARGET: {
+        /* arachnae_leg_target_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_leg_target.phase = (uint8_t)((unsigned)payload[0]);
+        node->msg.rx_leg_target.x = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[1] << 8) | (unsigned)payload[2]), 0x8000u, 0xFFFFu);
+        node->msg.rx_leg_target.y = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[3] << 8) | (unsigned)payload[4]), 0x8000u, 0xFFFFu);
+        node->msg.rx_leg_target.z = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[5] << 8) | (unsigned)payload[6]), 0x8000u, 0xFFFFu);
+        node->msg.rx_leg_target.duration = (uint16_t)(((unsigned)payload[7] << 8) | (unsigned)payload[8]);
         lcp_on_leg_target(node, h, &node->msg.rx_leg_target);
         return ARACHNAE_OK;
+    }
     case ARACHNAE_OP_LEG_POLL:
         lcp_on_leg_poll(node, h);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_JOINT_FEEDBACK:
-        arachnae_joint_feedback_unpack(payload, h->length, &node->msg.rx_joint_feedback);
+    case ARACHNAE_OP_JOINT_FEEDBACK: {
+        /* arachnae_joint_feedback_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_joint_feedback.angle = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[0] << 8) | (unsigned)payload[1]), 0x8000u, 0xFFFFu);
+        node->msg.rx_joint_feedback.speed = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[2] << 8) | (unsigned)payload[3]), 0x8000u, 0xFFFFu);
+        node->msg.rx_joint_feedback.current = (uint16_t)(((unsigned)payload[4] << 8) | (unsigned)payload[5]);
+        node->msg.rx_joint_feedback.temperature = (int8_t)arachnae_sext((uint16_t)((unsigned)payload[6]), 0x80u, 0xFFu);
+        node->msg.rx_joint_feedback.flags = (uint8_t)((unsigned)payload[7]);
         lcp_on_joint_feedback(node, h, &node->msg.rx_joint_feedback);
         return ARACHNAE_OK;
+    }
     default:   /* not reached: the payload check refused every other opcode */
         return ARACHNAE_OPCODE;
     }

@@ -64,10 +64,12 @@ arachnae_status lsc_dispatch(lsc_node *node, const uint8_t *frame)
     case ARACHNAE_OP_XMIT_DATA:
         lsc_on_xmit_data(node, h);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_SET_ALARM_LSC:
-        arachnae_set_alarm_lsc_unpack(payload, h->length, &node->msg.rx_set_alarm_lsc);
+    case ARACHNAE_OP_SET_ALARM_LSC: {
+        /* arachnae_set_alarm_lsc_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_set_alarm_lsc.limit = (uint8_t)((unsigned)payload[0]);
         lsc_on_set_alarm_lsc(node, h, &node->msg.rx_set_alarm_lsc);
         return ARACHNAE_OK;
+    }
     default:   /* not reached: the payload check refused every other opcode */
         return ARACHNAE_OPCODE;
     }

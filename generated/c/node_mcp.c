@@ -47,36 +47,59 @@ arachnae_status mcp_dispatch(mcp_node *node, const uint8_t *frame)
     const uint8_t *payload = frame + ARACHNAE_FRAME_PAYLOAD;
     arachnae_frame_header(frame, h);
     switch (h->opcode) {
-    case ARACHNAE_OP_ID_ACK:
-        arachnae_id_ack_unpack(payload, h->length, &node->msg.rx_id_ack);
+    case ARACHNAE_OP_ID_ACK: {
+        /* arachnae_id_ack_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_id_ack.address = (uint8_t)((unsigned)payload[0]);
         mcp_on_id_ack(node, h, &node->msg.rx_id_ack);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_STATUS_ACK_BUSY:
-        arachnae_status_ack_busy_unpack(payload, h->length, &node->msg.rx_status_ack_busy);
+    }
+    case ARACHNAE_OP_STATUS_ACK_BUSY: {
+        /* arachnae_status_ack_busy_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_status_ack_busy.status = (uint8_t)((unsigned)payload[0]);
         mcp_on_status_ack_busy(node, h, &node->msg.rx_status_ack_busy);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_STATUS_ACK_MMC:
-        arachnae_status_ack_mmc_unpack(payload, h->length, &node->msg.rx_status_ack_mmc);
+    }
+    case ARACHNAE_OP_STATUS_ACK_MMC: {
+        /* arachnae_status_ack_mmc_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_status_ack_mmc.gait = (uint8_t)((((unsigned)payload[0] >> 4) & 0x0Fu));
+        node->msg.rx_status_ack_mmc.direction = (uint8_t)(((unsigned)payload[0] & 0x0Fu));
+        node->msg.rx_status_ack_mmc.leg = (uint8_t)((((unsigned)payload[1] >> 4) & 0x0Fu));
+        node->msg.rx_status_ack_mmc.error = (uint8_t)(((unsigned)payload[1] & 0x0Fu));
         mcp_on_status_ack_mmc(node, h, &node->msg.rx_status_ack_mmc);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_POST_REPORT:
-        arachnae_post_report_unpack(payload, h->length, &node->msg.rx_post_report);
+    }
+    case ARACHNAE_OP_POST_REPORT: {
+        /* arachnae_post_report_unpack, inlined: one call less per message (issue 15) */
+        uint16_t i;
+        node->msg.rx_post_report.missing_count = (uint8_t)((unsigned)payload[0]);
+        for (i = 0; i < (uint16_t)(h->length - 1u); i++)
+            node->msg.rx_post_report.missing[i] = payload[1u + i];
         mcp_on_post_report(node, h, &node->msg.rx_post_report);
         return ARACHNAE_OK;
+    }
     case ARACHNAE_OP_POST_REQ:
         mcp_on_post_req(node, h);
         return ARACHNAE_OK;
     case ARACHNAE_OP_XMIT_REQ:
         mcp_on_xmit_req(node, h);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_XMIT_RECORD:
-        arachnae_xmit_record_unpack(payload, h->length, &node->msg.rx_xmit_record);
+    case ARACHNAE_OP_XMIT_RECORD: {
+        /* arachnae_xmit_record_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_xmit_record.target = (uint8_t)((unsigned)payload[0]);
+        node->msg.rx_xmit_record.source = (uint8_t)((unsigned)payload[1]);
+        node->msg.rx_xmit_record.kind = (uint8_t)((unsigned)payload[2]);
+        node->msg.rx_xmit_record.channel = (uint16_t)(((unsigned)payload[3] << 8) | (unsigned)payload[4]);
+        node->msg.rx_xmit_record.value = (uint8_t)((unsigned)payload[5]);
         mcp_on_xmit_record(node, h, &node->msg.rx_xmit_record);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_MOVE:
-        arachnae_move_unpack(payload, h->length, &node->msg.rx_move);
+    }
+    case ARACHNAE_OP_MOVE: {
+        /* arachnae_move_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_move.mov_cmd = (uint8_t)((((unsigned)payload[0] >> 4) & 0x0Fu));
+        node->msg.rx_move.param = (uint8_t)(((unsigned)payload[0] & 0x0Fu));
         mcp_on_move(node, h, &node->msg.rx_move);
         return ARACHNAE_OK;
+    }
     default:   /* not reached: the payload check refused every other opcode */
         return ARACHNAE_OPCODE;
     }

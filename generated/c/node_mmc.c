@@ -72,29 +72,48 @@ arachnae_status mmc_dispatch(mmc_node *node, const uint8_t *frame)
         op = ARACHNAE_OP_STATUS_ACK_MMC;
         n = arachnae_status_ack_mmc_pack(&node->msg.reply_status, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
-    case ARACHNAE_OP_ID_ACK:
-        arachnae_id_ack_unpack(payload, h->length, &node->msg.rx_id_ack);
+    case ARACHNAE_OP_ID_ACK: {
+        /* arachnae_id_ack_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_id_ack.address = (uint8_t)((unsigned)payload[0]);
         mmc_on_id_ack(node, h, &node->msg.rx_id_ack);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_STATUS_ACK_ORDER:
-        arachnae_status_ack_order_unpack(payload, h->length, &node->msg.rx_status_ack_order);
+    }
+    case ARACHNAE_OP_STATUS_ACK_ORDER: {
+        /* arachnae_status_ack_order_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_status_ack_order.status = (uint8_t)((unsigned)payload[0]);
         mmc_on_status_ack_order(node, h, &node->msg.rx_status_ack_order);
         return ARACHNAE_OK;
+    }
     case ARACHNAE_OP_POST_QUERY:
         mmc_on_post_query(node, h);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_POST_REPORT:
-        arachnae_post_report_unpack(payload, h->length, &node->msg.rx_post_report);
+    case ARACHNAE_OP_POST_REPORT: {
+        /* arachnae_post_report_unpack, inlined: one call less per message (issue 15) */
+        uint16_t i;
+        node->msg.rx_post_report.missing_count = (uint8_t)((unsigned)payload[0]);
+        for (i = 0; i < (uint16_t)(h->length - 1u); i++)
+            node->msg.rx_post_report.missing[i] = payload[1u + i];
         mmc_on_post_report(node, h, &node->msg.rx_post_report);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_MOVE_RELAYED:
-        arachnae_move_relayed_unpack(payload, h->length, &node->msg.rx_move_relayed);
+    }
+    case ARACHNAE_OP_MOVE_RELAYED: {
+        /* arachnae_move_relayed_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_move_relayed.address = (uint8_t)((unsigned)payload[0]);
+        node->msg.rx_move_relayed.mov_cmd = (uint8_t)((((unsigned)payload[1] >> 4) & 0x0Fu));
+        node->msg.rx_move_relayed.param = (uint8_t)(((unsigned)payload[1] & 0x0Fu));
         mmc_on_move_relayed(node, h, &node->msg.rx_move_relayed);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_LEG_REPORT:
-        arachnae_leg_report_unpack(payload, h->length, &node->msg.rx_leg_report);
+    }
+    case ARACHNAE_OP_LEG_REPORT: {
+        /* arachnae_leg_report_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_leg_report.flags = (uint8_t)((unsigned)payload[0]);
+        node->msg.rx_leg_report.x = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[1] << 8) | (unsigned)payload[2]), 0x8000u, 0xFFFFu);
+        node->msg.rx_leg_report.y = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[3] << 8) | (unsigned)payload[4]), 0x8000u, 0xFFFFu);
+        node->msg.rx_leg_report.z = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[5] << 8) | (unsigned)payload[6]), 0x8000u, 0xFFFFu);
+        node->msg.rx_leg_report.servo_temp = (int8_t)arachnae_sext((uint16_t)((unsigned)payload[7]), 0x80u, 0xFFu);
         mmc_on_leg_report(node, h, &node->msg.rx_leg_report);
         return ARACHNAE_OK;
+    }
     default:   /* not reached: the payload check refused every other opcode */
         return ARACHNAE_OPCODE;
     }

@@ -84,18 +84,24 @@ arachnae_status spu_dispatch(spu_node *node, const uint8_t *frame)
         op = ARACHNAE_OP_STATUS_ACK_BUSY;
         n = arachnae_status_ack_busy_pack(&node->msg.reply_status, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
-    case ARACHNAE_OP_ID_ACK:
-        arachnae_id_ack_unpack(payload, h->length, &node->msg.rx_id_ack);
+    case ARACHNAE_OP_ID_ACK: {
+        /* arachnae_id_ack_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_id_ack.address = (uint8_t)((unsigned)payload[0]);
         spu_on_id_ack(node, h, &node->msg.rx_id_ack);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_STATUS_ACK_ORDER:
-        arachnae_status_ack_order_unpack(payload, h->length, &node->msg.rx_status_ack_order);
+    }
+    case ARACHNAE_OP_STATUS_ACK_ORDER: {
+        /* arachnae_status_ack_order_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_status_ack_order.status = (uint8_t)((unsigned)payload[0]);
         spu_on_status_ack_order(node, h, &node->msg.rx_status_ack_order);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_STATUS_ACK_RANGE:
-        arachnae_status_ack_range_unpack(payload, h->length, &node->msg.rx_status_ack_range);
+    }
+    case ARACHNAE_OP_STATUS_ACK_RANGE: {
+        /* arachnae_status_ack_range_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_status_ack_range.status = (uint8_t)((unsigned)payload[0]);
         spu_on_status_ack_range(node, h, &node->msg.rx_status_ack_range);
         return ARACHNAE_OK;
+    }
     case ARACHNAE_OP_POST_QUERY:
         spu_on_post_query(node, h);
         return ARACHNAE_OK;
@@ -114,34 +120,53 @@ arachnae_status spu_dispatch(spu_node *node, const uint8_t *frame)
     case ARACHNAE_OP_OBJ_BOTH:
         spu_on_obj_both(node, h);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_XMIT_DATA_USRC:
-        arachnae_xmit_data_usrc_unpack(payload, h->length, &node->msg.rx_xmit_data_usrc);
+    case ARACHNAE_OP_XMIT_DATA_USRC: {
+        /* arachnae_xmit_data_usrc_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_xmit_data_usrc.distance = (uint8_t)((unsigned)payload[0]);
+        node->msg.rx_xmit_data_usrc.angle = (uint16_t)(((unsigned)payload[1] << 8) | (unsigned)payload[2]);
         spu_on_xmit_data_usrc(node, h, &node->msg.rx_xmit_data_usrc);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_XMIT_DATA_TPSC:
-        arachnae_xmit_data_tpsc_unpack(payload, h->length, &node->msg.rx_xmit_data_tpsc);
+    }
+    case ARACHNAE_OP_XMIT_DATA_TPSC: {
+        /* arachnae_xmit_data_tpsc_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_xmit_data_tpsc.contact = (uint8_t)((unsigned)payload[0]);
         spu_on_xmit_data_tpsc(node, h, &node->msg.rx_xmit_data_tpsc);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_XMIT_DATA_IRRC:
-        arachnae_xmit_data_irrc_unpack(payload, h->length, &node->msg.rx_xmit_data_irrc);
+    }
+    case ARACHNAE_OP_XMIT_DATA_IRRC: {
+        /* arachnae_xmit_data_irrc_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_xmit_data_irrc.left = (uint8_t)((unsigned)payload[0]);
+        node->msg.rx_xmit_data_irrc.center = (uint8_t)((unsigned)payload[1]);
+        node->msg.rx_xmit_data_irrc.right = (uint8_t)((unsigned)payload[2]);
         spu_on_xmit_data_irrc(node, h, &node->msg.rx_xmit_data_irrc);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_XMIT_DATA_ISC:
-        arachnae_xmit_data_isc_unpack(payload, h->length, &node->msg.rx_xmit_data_isc);
+    }
+    case ARACHNAE_OP_XMIT_DATA_ISC: {
+        /* arachnae_xmit_data_isc_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_xmit_data_isc.longitudinal = (int8_t)arachnae_sext((uint16_t)((unsigned)payload[0]), 0x80u, 0xFFu);
+        node->msg.rx_xmit_data_isc.transverse = (int8_t)arachnae_sext((uint16_t)((unsigned)payload[1]), 0x80u, 0xFFu);
         spu_on_xmit_data_isc(node, h, &node->msg.rx_xmit_data_isc);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_XMIT_DATA_TSC:
-        arachnae_xmit_data_tsc_unpack(payload, h->length, &node->msg.rx_xmit_data_tsc);
+    }
+    case ARACHNAE_OP_XMIT_DATA_TSC: {
+        /* arachnae_xmit_data_tsc_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_xmit_data_tsc.channel = (uint8_t)((unsigned)payload[0]);
+        node->msg.rx_xmit_data_tsc.temperature = (int8_t)arachnae_sext((uint16_t)((unsigned)payload[1]), 0x80u, 0xFFu);
         spu_on_xmit_data_tsc(node, h, &node->msg.rx_xmit_data_tsc);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_XMIT_DATA_LSC:
-        arachnae_xmit_data_lsc_unpack(payload, h->length, &node->msg.rx_xmit_data_lsc);
+    }
+    case ARACHNAE_OP_XMIT_DATA_LSC: {
+        /* arachnae_xmit_data_lsc_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_xmit_data_lsc.brightness = (uint8_t)((unsigned)payload[0]);
         spu_on_xmit_data_lsc(node, h, &node->msg.rx_xmit_data_lsc);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_XMIT_DATA_PSC:
-        arachnae_xmit_data_psc_unpack(payload, h->length, &node->msg.rx_xmit_data_psc);
+    }
+    case ARACHNAE_OP_XMIT_DATA_PSC: {
+        /* arachnae_xmit_data_psc_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_xmit_data_psc.voltage = (uint8_t)((unsigned)payload[0]);
         spu_on_xmit_data_psc(node, h, &node->msg.rx_xmit_data_psc);
         return ARACHNAE_OK;
+    }
     default:   /* not reached: the payload check refused every other opcode */
         return ARACHNAE_OPCODE;
     }

@@ -64,18 +64,34 @@ arachnae_status ssc_dispatch(ssc_node *node, const uint8_t *frame)
         op = ARACHNAE_OP_STATUS_ACK_BUSY;
         n = arachnae_status_ack_busy_pack(&node->msg.reply_status, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
-    case ARACHNAE_OP_SETUP:
-        arachnae_setup_unpack(payload, h->length, &node->msg.rx_setup);
+    case ARACHNAE_OP_SETUP: {
+        /* arachnae_setup_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_setup.rate = (uint8_t)((((unsigned)payload[0] >> 4) & 0x0Fu));
+        node->msg.rx_setup.amplitude = (uint8_t)(((unsigned)payload[0] & 0x0Fu));
+        node->msg.rx_setup.inflection = (uint8_t)((unsigned)payload[1]);
+        node->msg.rx_setup.articulation = (uint8_t)((((unsigned)payload[2] >> 5) & 0x07u));
+        node->msg.rx_setup.reserved = (uint8_t)(((unsigned)payload[2] & 0x1Fu));
         ssc_on_setup(node, h, &node->msg.rx_setup);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_SPEAK:
-        arachnae_speak_unpack(payload, h->length, &node->msg.rx_speak);
+    }
+    case ARACHNAE_OP_SPEAK: {
+        /* arachnae_speak_unpack, inlined: one call less per message (issue 15) */
+        uint16_t i;
+        node->msg.rx_speak.repeat = (uint8_t)((unsigned)payload[0]);
+        node->msg.rx_speak.length = (uint8_t)((unsigned)payload[1]);
+        for (i = 0; i < (uint16_t)(h->length - 2u); i++)
+            node->msg.rx_speak.text[i] = payload[2u + i];
         ssc_on_speak(node, h, &node->msg.rx_speak);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_SPEAK_RESIDENT:
-        arachnae_speak_resident_unpack(payload, h->length, &node->msg.rx_speak_resident);
+    }
+    case ARACHNAE_OP_SPEAK_RESIDENT: {
+        /* arachnae_speak_resident_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_speak_resident.repeat = (uint8_t)((unsigned)payload[0]);
+        node->msg.rx_speak_resident.length = (uint8_t)((unsigned)payload[1]);
+        node->msg.rx_speak_resident.index = (uint8_t)((unsigned)payload[2]);
         ssc_on_speak_resident(node, h, &node->msg.rx_speak_resident);
         return ARACHNAE_OK;
+    }
     default:   /* not reached: the payload check refused every other opcode */
         return ARACHNAE_OPCODE;
     }

@@ -66,14 +66,22 @@ arachnae_status uic_rcp_dispatch(uic_rcp_node *node, const uint8_t *frame)
     case ARACHNAE_OP_XMIT_GRANT:
         uic_rcp_on_xmit_grant(node, h);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_LCD_TEXT:
-        arachnae_lcd_text_unpack(payload, h->length, &node->msg.rx_lcd_text);
+    case ARACHNAE_OP_LCD_TEXT: {
+        /* arachnae_lcd_text_unpack, inlined: one call less per message (issue 15) */
+        uint16_t i;
+        node->msg.rx_lcd_text.line = (uint8_t)((unsigned)payload[0]);
+        node->msg.rx_lcd_text.length = (uint8_t)((unsigned)payload[1]);
+        for (i = 0; i < (uint16_t)(h->length - 2u); i++)
+            node->msg.rx_lcd_text.text[i] = payload[2u + i];
         uic_rcp_on_lcd_text(node, h, &node->msg.rx_lcd_text);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_UIC_ALERT:
-        arachnae_uic_alert_unpack(payload, h->length, &node->msg.rx_uic_alert);
+    }
+    case ARACHNAE_OP_UIC_ALERT: {
+        /* arachnae_uic_alert_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_uic_alert.alert = (uint8_t)((unsigned)payload[0]);
         uic_rcp_on_uic_alert(node, h, &node->msg.rx_uic_alert);
         return ARACHNAE_OK;
+    }
     default:   /* not reached: the payload check refused every other opcode */
         return ARACHNAE_OPCODE;
     }

@@ -66,14 +66,18 @@ arachnae_status usrc_dispatch(usrc_node *node, const uint8_t *frame)
         op = ARACHNAE_OP_STATUS_ACK_RANGE;
         n = arachnae_status_ack_range_pack(&node->msg.reply_status, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
-    case ARACHNAE_OP_HEAD_SET_ABS:
-        arachnae_head_set_abs_unpack(payload, h->length, &node->msg.rx_head_set_abs);
+    case ARACHNAE_OP_HEAD_SET_ABS: {
+        /* arachnae_head_set_abs_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_head_set_abs.angle = (uint16_t)(((unsigned)payload[0] << 8) | (unsigned)payload[1]);
         usrc_on_head_set_abs(node, h, &node->msg.rx_head_set_abs);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_HEAD_SET_REL:
-        arachnae_head_set_rel_unpack(payload, h->length, &node->msg.rx_head_set_rel);
+    }
+    case ARACHNAE_OP_HEAD_SET_REL: {
+        /* arachnae_head_set_rel_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_head_set_rel.angle = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[0] << 8) | (unsigned)payload[1]), 0x8000u, 0xFFFFu);
         usrc_on_head_set_rel(node, h, &node->msg.rx_head_set_rel);
         return ARACHNAE_OK;
+    }
     case ARACHNAE_OP_HEAD_STEP:
         usrc_on_head_step(node, h);
         return ARACHNAE_OK;
