@@ -19,8 +19,9 @@
 void fw_rx_byte(uint8_t byte);
 void fw_rx_gap(void);
 /* Counters of main.c a debugger or a behaviour can read: frames for us, frames refused (any
- * reason, also frames for other nodes), overruns, and corrupt frames heard (collisions). */
-extern volatile uint16_t fw_rx_frames, fw_rx_errors, fw_rx_overruns, fw_rx_corrupt;
+ * reason, also frames for other nodes), overruns, checked requests the skeleton could not answer,
+ * and corrupt frames heard (collisions). */
+extern volatile uint16_t fw_rx_frames, fw_rx_errors, fw_rx_overruns, fw_rx_unanswered, fw_rx_corrupt;
 /* What the line carried (main.c, every frame heard, whoever it was for): hal_ms() when the last corrupt
  * frame ended, and characters of intact frames other than the bus's request message (the backoff window's
  * slots are idle slots, behaviours/runtime.py). */

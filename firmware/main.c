@@ -10,13 +10,15 @@
 
 static uint8_t rx_buf[FW_RX_MAX];      /* the parser's frame buffer (ISR side) */
 static uint8_t frame_buf[FW_RX_MAX];   /* a checked frame waiting for dispatch (main side) */
-static volatile uint16_t frame_len;  /* stable while frame_ready is 1 */
 static volatile uint8_t frame_ready;   /* a byte: read atomically on an 8-bit core */
-static arachnae_parser parser;
+/* initialised at build time: the role's own address and payload check are constants (no init code, issue 15) */
+static arachnae_parser parser = ARACHNAE_PARSER_INIT(rx_buf, FW_RX_MAX, FW_OWN_ADDRESS, FW_ROLE_CHECK);
 static FW_ROLE_NODE node;
 
-/* Counters a debugger or a test can read. */
-volatile uint16_t fw_rx_frames, fw_rx_errors, fw_rx_overruns;
+/* Counters a debugger or a test can read. fw_rx_errors: frames the parser refused (envelope, OPCODE, LENGTH,
+ * RANGE; RX interrupt); fw_rx_unanswered: checked requests the skeleton could not answer (main loop, issue 10:
+ * nothing dropped silently). */
+volatile uint16_t fw_rx_frames, fw_rx_errors, fw_rx_overruns, fw_rx_unanswered;
 /* Frames heard corrupt (CRC, cut short, too long): a collision on the bus, whoever it was for. */
 volatile uint16_t fw_rx_corrupt;
 volatile uint16_t fw_rx_corrupt_ms, fw_rx_pause_chars;
@@ -71,7 +73,6 @@ void fw_rx_byte(uint8_t byte)
     for (i = 0; i < n; i++)
         frame_buf[i] = f[i];
     fw_rx_frames++;
-    frame_len = n;
     frame_ready = 1;
 }
 
@@ -87,13 +88,14 @@ int main(void)
 {
     hal_init();
     (void)FW_ROLE_INIT(&node, FW_OWN_ADDRESS, 0);
-    arachnae_parser_init(&parser, rx_buf, FW_RX_MAX, FW_OWN_ADDRESS, FW_ROLE_CHECK);
     fw_behaviour_init(&node);
     hal_enable_interrupts();
     for (;;) {
-        /* the ISR writes frame_buf and frame_len only while frame_ready is 0 */
+        /* the ISR writes frame_buf only while frame_ready is 0; the parser checked it (own address, role's
+           payload check), so the skeleton decodes it without checking again */
         if (frame_ready) {
-            (void)FW_ROLE_DISPATCH(&node, frame_buf, frame_len);
+            if (FW_ROLE_DISPATCH(&node, frame_buf) != ARACHNAE_OK)
+                fw_rx_unanswered++;
             frame_ready = 0;
         }
         fw_behaviour_poll(&node, hal_ms());

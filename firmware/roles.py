@@ -204,16 +204,19 @@ def fuzz_roles(spec) -> str:
     out += [f'#include "node_{r.lower()}.h"' for r in spec.roles]
     out += ["", "typedef struct {", "    const char *name;",
             "    arachnae_payload_check_fn check;",
-            "    /* NONE if `own` is not an address of the role, else the dispatch status */",
-            "    arachnae_status (*dispatch)(uint8_t own, const uint8_t *frame, uint16_t len);",
+            "    /* NONE if `own` is not an address of the role, else the dispatch status of a frame the",
+            "     * role's parser passed (dispatch takes only those: it does not check again, issue 15), OK for NULL */",
+            "    arachnae_status (*dispatch)(uint8_t own, const uint8_t *frame);",
             "} fz_role;", ""]
     for r in spec.roles:
         low = r.lower()
-        out += [f"static arachnae_status fz_dispatch_{low}(uint8_t own, const uint8_t *frame, uint16_t len)", "{",
+        out += [f"static arachnae_status fz_dispatch_{low}(uint8_t own, const uint8_t *frame)", "{",
                 f"    {low}_node node;",
                 f"    if ({low}_node_init(&node, own, 0) != ARACHNAE_OK)",
                 "        return ARACHNAE_NONE;",
-                f"    return {low}_dispatch(&node, frame, len);", "}", ""]
+                "    if (frame == 0)",
+                "        return ARACHNAE_OK;   /* only asked whether own is an address of the role */",
+                f"    return {low}_dispatch(&node, frame);", "}", ""]
     out += [f"static const fz_role fz_roles[{len(spec.roles)}] = {{"]
     out += [f'    {{"{r}", {r.lower()}_payload_check, fz_dispatch_{r.lower()}}},' for r in spec.roles]
     out += ["};", ""]

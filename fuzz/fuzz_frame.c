@@ -35,14 +35,15 @@ static void fail(const char *what, int a, int b)
 }
 
 /* Verdict of the byte parser for one burst: the last status feed() reported (an
- * OVERSIZE supersedes an earlier OK), else what the gap reports. */
-static arachnae_status parse_burst(const uint8_t *data, uint16_t len, uint16_t own, arachnae_payload_check_fn check)
+ * OVERSIZE supersedes an earlier OK), else what the gap reports. With `passed`: the frame the
+ * parser holds after an OK verdict (in buf, ARACHNAE_MAX_FRAME bytes), else NULL. */
+static arachnae_status parse_burst(const uint8_t *data, uint16_t len, uint16_t own, arachnae_payload_check_fn check,
+                                   uint8_t *buf, const uint8_t **passed)
 {
-    uint8_t buf[ARACHNAE_MAX_FRAME];
     arachnae_parser p;
     arachnae_status verdict = ARACHNAE_NONE, st;
     uint16_t i, flen = 0;
-    arachnae_parser_init(&p, buf, sizeof buf, own, check);
+    arachnae_parser_init(&p, buf, ARACHNAE_MAX_FRAME, own, check);
     for (i = 0; i < len; i++) {
         st = arachnae_parser_feed(&p, data[i]);
         if (st != ARACHNAE_NONE)
@@ -53,6 +54,8 @@ static arachnae_status parse_burst(const uint8_t *data, uint16_t len, uint16_t o
     st = arachnae_parser_gap(&p);
     if (verdict == ARACHNAE_NONE)
         verdict = st;
+    if (passed != NULL)
+        *passed = (verdict == ARACHNAE_OK) ? arachnae_parser_frame(&p, &flen) : NULL;
     /* after the gap the parser is ready again: a valid frame goes through */
     return verdict;
 }
@@ -62,13 +65,14 @@ static void check_frame(uint8_t own, const uint8_t *frame, uint16_t len)
     arachnae_header h;
     arachnae_message m;
     arachnae_status whole, parsed;
+    uint8_t pbuf[ARACHNAE_MAX_FRAME];
     size_t r;
 
     /* 1. whole frame vs byte parser, generic payload check */
     memset(&m, 0xA5, sizeof m);
     whole = arachnae_frame_decode(frame, len, own, &h, &m);
     if (len > 0u) {
-        parsed = parse_burst(frame, len, own, arachnae_payload_check);
+        parsed = parse_burst(frame, len, own, arachnae_payload_check, pbuf, NULL);
         if (parsed != whole)
             fail("byte parser and whole-frame check disagree", (int)parsed, (int)whole);
     }
@@ -84,26 +88,30 @@ static void check_frame(uint8_t own, const uint8_t *frame, uint16_t len)
             fail("re-encoding differs from the frame", (int)n, (int)len);
     }
 
-    /* 3. the skeleton of the role that owns `own` */
+    /* 3. the skeleton of the role that owns `own`: its parser agrees with the whole-frame verdict, and
+     * dispatch takes every frame that parser passes */
     for (r = 0; r < FZ_ROLES; r++) {
-        arachnae_status disp = fz_roles[r].dispatch(own, frame, len), expect, role_parsed;
-        if (disp == ARACHNAE_NONE)
+        arachnae_status disp, expect, role_parsed;
+        const uint8_t *passed = NULL;
+        if (fz_roles[r].dispatch(own, NULL) == ARACHNAE_NONE)
             continue;   /* own is not an address of this role */
         expect = whole;
         if ((whole == ARACHNAE_OK || whole >= ARACHNAE_OPCODE) && len >= ARACHNAE_FRAME_OVERHEAD
             && fz_roles[r].check(frame[ARACHNAE_FRAME_OPCODE], frame + ARACHNAE_FRAME_PAYLOAD,
                                  frame[ARACHNAE_FRAME_LENGTH]) == ARACHNAE_OPCODE)
             expect = ARACHNAE_OPCODE;
-        if (len > 0u) {
-            role_parsed = parse_burst(frame, len, own, fz_roles[r].check);
-            if (role_parsed != expect)
-                fail(fz_roles[r].name, (int)role_parsed, (int)expect);
-        }
+        if (len == 0u)
+            continue;
+        role_parsed = parse_burst(frame, len, own, fz_roles[r].check, pbuf, &passed);
+        if (role_parsed != expect)
+            fail(fz_roles[r].name, (int)role_parsed, (int)expect);
+        if (passed == NULL)
+            continue;
+        disp = fz_roles[r].dispatch(own, passed);
         /* the skeleton answers STATUS_REQ with what the (empty) behaviour filled in,
-         * which may be out of range (RANGE from the reply's encode); all else matches */
-        if (disp != expect && !(expect == ARACHNAE_OK && frame[ARACHNAE_FRAME_OPCODE] == ARACHNAE_OP_STATUS_REQ
-                                && disp == ARACHNAE_RANGE))
-            fail("dispatch disagrees with the whole-frame check", (int)disp, (int)expect);
+         * which may be out of range (RANGE from the reply's check); all else is delivered */
+        if (disp != ARACHNAE_OK && !(frame[ARACHNAE_FRAME_OPCODE] == ARACHNAE_OP_STATUS_REQ && disp == ARACHNAE_RANGE))
+            fail("dispatch refuses a frame its parser passed", (int)disp, (int)ARACHNAE_OK);
     }
 
     /* 4. payload decoders on an exact-size heap copy of the claimed payload */

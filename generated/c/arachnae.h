@@ -461,33 +461,12 @@ static inline void arachnae_frame_header(const uint8_t *frame, arachnae_header *
 /* The payload is already at frame + ARACHNAE_FRAME_PAYLOAD: write header and CRC. */
 arachnae_status arachnae_frame_finish(uint8_t *frame, uint16_t cap, uint8_t dst, uint8_t src, uint8_t opcode,
                                       uint8_t payload_len, uint16_t *frame_len);
-/* Writes header and CRC around the payload_len bytes at frame + ARACHNAE_FRAME_PAYLOAD, sets
- * *frame_len, returns OK; the caller checked that ARACHNAE_FRAME_OVERHEAD + payload_len bytes fit.
- * (Argument order as the generated _build functions', so that they end in a jump here.) */
-arachnae_status arachnae_frame_seal(uint8_t opcode, uint8_t dst, uint8_t src, uint8_t *frame, uint8_t payload_len,
-                                    uint16_t *frame_len);
+/* Writes dst, src and the CRC around the opcode, length byte and payload the caller put in the frame, sets
+ * *frame_len, returns OK; the caller checked that ARACHNAE_FRAME_OVERHEAD + length bytes fit. Four
+ * arguments: on an 8-bit core all in call-clobbered registers, so no caller saves any (issue 15). */
+arachnae_status arachnae_frame_seal(uint8_t *frame, uint8_t dst, uint8_t src, uint16_t *frame_len);
 /* Envelope check: TRUNCATED/OVERSIZE, CHECKSUM, ADDRESS (own = ARACHNAE_ANY_ADDRESS skips it), then ROUTE. */
 arachnae_status arachnae_frame_check(const uint8_t *frame, uint16_t len, uint16_t own);
-
-/* Frames a node checked but delivered to no callback (issue 10: never dropped silently): how many
- * (saturating at 0xFFFF), and the opcode and status of the last one. Lives in the caller's node state. */
-typedef struct {
-    uint16_t count;
-    uint8_t opcode;
-    uint8_t status;
-} arachnae_unhandled;
-
-/* Records `st` for `opcode` when it is not OK; returns st. */
-static inline arachnae_status arachnae_unhandled_note(arachnae_unhandled *u, uint8_t opcode, arachnae_status st)
-{
-    if (st != ARACHNAE_OK) {
-        if (u->count != 0xFFFFu)
-            u->count++;
-        u->opcode = opcode;
-        u->status = (uint8_t)st;
-    }
-    return st;
-}
 
 /* ---- byte-at-a-time parser (UART RX interrupt) ----
  * feed() returns ARACHNAE_NONE while a frame is incomplete, ARACHNAE_OK when a
@@ -514,10 +493,21 @@ typedef struct {
 
 void arachnae_parser_init(arachnae_parser *p, uint8_t *buf, uint16_t cap, uint16_t own,
                           arachnae_payload_check_fn check);
+/* The same as a static initializer, for a parser whose buffer, own address and check are known at build
+ * time: no code at all (issue 15), e.g. static arachnae_parser p = ARACHNAE_PARSER_INIT(buf, sizeof buf, own, check); */
+#define ARACHNAE_PARSER_INIT(buf, cap, own, check) { (buf), (cap), 0u, (own), 0u, (check) }
 arachnae_status arachnae_parser_feed(arachnae_parser *p, uint8_t byte);
 arachnae_status arachnae_parser_gap(arachnae_parser *p);
-/* The last complete and valid frame (NULL if none since the last gap). */
-const uint8_t *arachnae_parser_frame(const arachnae_parser *p, uint16_t *len);
+/* The last complete and valid frame (NULL if none since the last gap). Inline: a field read, not
+ * worth a call (issue 15). READY and HELD, the parser's two states with a valid frame, are the highest. */
+#define ARACHNAE_PARSER_READY 3u
+static inline const uint8_t *arachnae_parser_frame(const arachnae_parser *p, uint16_t *len)
+{
+    if (p->state < ARACHNAE_PARSER_READY)
+        return 0;
+    *len = p->count;
+    return p->buf;
+}
 
 /* ---- messages ----
  * For each message X:
@@ -544,7 +534,7 @@ typedef struct {
 
 arachnae_status arachnae_id_ack_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_id_ack_decode(const uint8_t *payload, uint8_t len, arachnae_id_ack_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_id_ack_unpack(const uint8_t *payload, uint8_t len, arachnae_id_ack_t *out);
 arachnae_status arachnae_id_ack_check(const arachnae_id_ack_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -565,7 +555,7 @@ typedef struct {
 
 arachnae_status arachnae_status_ack_busy_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_status_ack_busy_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_busy_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_status_ack_busy_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_busy_t *out);
 arachnae_status arachnae_status_ack_busy_check(const arachnae_status_ack_busy_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -582,7 +572,7 @@ typedef struct {
 
 arachnae_status arachnae_status_ack_order_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_status_ack_order_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_order_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_status_ack_order_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_order_t *out);
 arachnae_status arachnae_status_ack_order_check(const arachnae_status_ack_order_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -599,7 +589,7 @@ typedef struct {
 
 arachnae_status arachnae_status_ack_range_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_status_ack_range_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_range_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_status_ack_range_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_range_t *out);
 arachnae_status arachnae_status_ack_range_check(const arachnae_status_ack_range_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -619,7 +609,7 @@ typedef struct {
 
 arachnae_status arachnae_status_ack_mmc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_status_ack_mmc_decode(const uint8_t *payload, uint8_t len, arachnae_status_ack_mmc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_status_ack_mmc_unpack(const uint8_t *payload, uint8_t len, arachnae_status_ack_mmc_t *out);
 arachnae_status arachnae_status_ack_mmc_check(const arachnae_status_ack_mmc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -641,7 +631,7 @@ typedef struct {
 
 arachnae_status arachnae_post_report_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_post_report_decode(const uint8_t *payload, uint8_t len, arachnae_post_report_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_post_report_unpack(const uint8_t *payload, uint8_t len, arachnae_post_report_t *out);
 arachnae_status arachnae_post_report_check(const arachnae_post_report_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -674,7 +664,7 @@ typedef struct {
 
 arachnae_status arachnae_xmit_record_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_record_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_record_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_xmit_record_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_record_t *out);
 arachnae_status arachnae_xmit_record_check(const arachnae_xmit_record_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -694,7 +684,7 @@ typedef struct {
 
 arachnae_status arachnae_data_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_data_decode(const uint8_t *payload, uint8_t len, arachnae_data_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_data_unpack(const uint8_t *payload, uint8_t len, arachnae_data_t *out);
 arachnae_status arachnae_data_check(const arachnae_data_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -712,7 +702,7 @@ typedef struct {
 
 arachnae_status arachnae_move_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_move_decode(const uint8_t *payload, uint8_t len, arachnae_move_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_move_unpack(const uint8_t *payload, uint8_t len, arachnae_move_t *out);
 arachnae_status arachnae_move_check(const arachnae_move_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -731,7 +721,7 @@ typedef struct {
 
 arachnae_status arachnae_move_relayed_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_move_relayed_decode(const uint8_t *payload, uint8_t len, arachnae_move_relayed_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_move_relayed_unpack(const uint8_t *payload, uint8_t len, arachnae_move_relayed_t *out);
 arachnae_status arachnae_move_relayed_check(const arachnae_move_relayed_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -752,7 +742,7 @@ typedef struct {
 
 arachnae_status arachnae_setup_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_setup_decode(const uint8_t *payload, uint8_t len, arachnae_setup_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_setup_unpack(const uint8_t *payload, uint8_t len, arachnae_setup_t *out);
 arachnae_status arachnae_setup_check(const arachnae_setup_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -771,7 +761,7 @@ typedef struct {
 
 arachnae_status arachnae_speak_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_speak_decode(const uint8_t *payload, uint8_t len, arachnae_speak_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_speak_unpack(const uint8_t *payload, uint8_t len, arachnae_speak_t *out);
 arachnae_status arachnae_speak_check(const arachnae_speak_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -790,7 +780,7 @@ typedef struct {
 
 arachnae_status arachnae_speak_resident_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_speak_resident_decode(const uint8_t *payload, uint8_t len, arachnae_speak_resident_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_speak_resident_unpack(const uint8_t *payload, uint8_t len, arachnae_speak_resident_t *out);
 arachnae_status arachnae_speak_resident_check(const arachnae_speak_resident_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -809,7 +799,7 @@ typedef struct {
 
 arachnae_status arachnae_lcd_text_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_lcd_text_decode(const uint8_t *payload, uint8_t len, arachnae_lcd_text_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_lcd_text_unpack(const uint8_t *payload, uint8_t len, arachnae_lcd_text_t *out);
 arachnae_status arachnae_lcd_text_check(const arachnae_lcd_text_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -826,7 +816,7 @@ typedef struct {
 
 arachnae_status arachnae_uic_alert_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_uic_alert_decode(const uint8_t *payload, uint8_t len, arachnae_uic_alert_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_uic_alert_unpack(const uint8_t *payload, uint8_t len, arachnae_uic_alert_t *out);
 arachnae_status arachnae_uic_alert_check(const arachnae_uic_alert_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -843,7 +833,7 @@ typedef struct {
 
 arachnae_status arachnae_head_set_abs_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_head_set_abs_decode(const uint8_t *payload, uint8_t len, arachnae_head_set_abs_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_head_set_abs_unpack(const uint8_t *payload, uint8_t len, arachnae_head_set_abs_t *out);
 arachnae_status arachnae_head_set_abs_check(const arachnae_head_set_abs_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -860,7 +850,7 @@ typedef struct {
 
 arachnae_status arachnae_head_set_rel_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_head_set_rel_decode(const uint8_t *payload, uint8_t len, arachnae_head_set_rel_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_head_set_rel_unpack(const uint8_t *payload, uint8_t len, arachnae_head_set_rel_t *out);
 arachnae_status arachnae_head_set_rel_check(const arachnae_head_set_rel_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -910,7 +900,7 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_usrc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_usrc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_usrc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_xmit_data_usrc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_usrc_t *out);
 arachnae_status arachnae_xmit_data_usrc_check(const arachnae_xmit_data_usrc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -930,7 +920,7 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_tpsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_tpsc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_tpsc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_xmit_data_tpsc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_tpsc_t *out);
 arachnae_status arachnae_xmit_data_tpsc_check(const arachnae_xmit_data_tpsc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -949,7 +939,7 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_irrc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_irrc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_irrc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_xmit_data_irrc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_irrc_t *out);
 arachnae_status arachnae_xmit_data_irrc_check(const arachnae_xmit_data_irrc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -976,7 +966,7 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_isc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_isc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_isc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_xmit_data_isc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_isc_t *out);
 arachnae_status arachnae_xmit_data_isc_check(const arachnae_xmit_data_isc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -994,7 +984,7 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_tsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_tsc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_tsc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_xmit_data_tsc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_tsc_t *out);
 arachnae_status arachnae_xmit_data_tsc_check(const arachnae_xmit_data_tsc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1011,7 +1001,7 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_lsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_lsc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_lsc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_xmit_data_lsc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_lsc_t *out);
 arachnae_status arachnae_xmit_data_lsc_check(const arachnae_xmit_data_lsc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1031,7 +1021,7 @@ typedef struct {
 
 arachnae_status arachnae_xmit_data_psc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_xmit_data_psc_decode(const uint8_t *payload, uint8_t len, arachnae_xmit_data_psc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_xmit_data_psc_unpack(const uint8_t *payload, uint8_t len, arachnae_xmit_data_psc_t *out);
 arachnae_status arachnae_xmit_data_psc_check(const arachnae_xmit_data_psc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1051,7 +1041,7 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_irrc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_irrc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_irrc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_set_alarm_irrc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_irrc_t *out);
 arachnae_status arachnae_set_alarm_irrc_check(const arachnae_set_alarm_irrc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1072,7 +1062,7 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_isc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_isc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_isc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_set_alarm_isc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_isc_t *out);
 arachnae_status arachnae_set_alarm_isc_check(const arachnae_set_alarm_isc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1090,7 +1080,7 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_tsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_tsc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_tsc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_set_alarm_tsc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_tsc_t *out);
 arachnae_status arachnae_set_alarm_tsc_check(const arachnae_set_alarm_tsc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1107,7 +1097,7 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_lsc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_lsc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_lsc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_set_alarm_lsc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_lsc_t *out);
 arachnae_status arachnae_set_alarm_lsc_check(const arachnae_set_alarm_lsc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1127,7 +1117,7 @@ typedef struct {
 
 arachnae_status arachnae_set_alarm_psc_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_set_alarm_psc_decode(const uint8_t *payload, uint8_t len, arachnae_set_alarm_psc_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_set_alarm_psc_unpack(const uint8_t *payload, uint8_t len, arachnae_set_alarm_psc_t *out);
 arachnae_status arachnae_set_alarm_psc_check(const arachnae_set_alarm_psc_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1151,7 +1141,7 @@ typedef struct {
 
 arachnae_status arachnae_leg_target_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_leg_target_decode(const uint8_t *payload, uint8_t len, arachnae_leg_target_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_leg_target_unpack(const uint8_t *payload, uint8_t len, arachnae_leg_target_t *out);
 arachnae_status arachnae_leg_target_check(const arachnae_leg_target_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1185,7 +1175,7 @@ typedef struct {
 
 arachnae_status arachnae_leg_report_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_leg_report_decode(const uint8_t *payload, uint8_t len, arachnae_leg_report_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_leg_report_unpack(const uint8_t *payload, uint8_t len, arachnae_leg_report_t *out);
 arachnae_status arachnae_leg_report_check(const arachnae_leg_report_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1212,7 +1202,7 @@ typedef struct {
 
 arachnae_status arachnae_joint_target_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_joint_target_decode(const uint8_t *payload, uint8_t len, arachnae_joint_target_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_joint_target_unpack(const uint8_t *payload, uint8_t len, arachnae_joint_target_t *out);
 arachnae_status arachnae_joint_target_check(const arachnae_joint_target_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that
@@ -1243,7 +1233,7 @@ typedef struct {
 
 arachnae_status arachnae_joint_feedback_validate(const uint8_t *payload, uint8_t len);
 arachnae_status arachnae_joint_feedback_decode(const uint8_t *payload, uint8_t len, arachnae_joint_feedback_t *out);
-/* decode without the checks, for a payload that passed validate (the node skeleton's path) */
+/* decode without the checks, for a payload that passed validate (the node skeletons inline the same code, unpack.j2) */
 void arachnae_joint_feedback_unpack(const uint8_t *payload, uint8_t len, arachnae_joint_feedback_t *out);
 arachnae_status arachnae_joint_feedback_check(const arachnae_joint_feedback_t *m);
 /* the payload bytes of a struct that passed check, returns their number; the caller checked that

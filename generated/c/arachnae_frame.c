@@ -51,18 +51,15 @@ uint16_t arachnae_crc16(const uint8_t *data, uint16_t len)
     return (uint16_t)(crc ^ ARACHNAE_CRC_XOROUT);
 }
 
-arachnae_status arachnae_frame_seal(uint8_t opcode, uint8_t dst, uint8_t src, uint8_t *frame, uint8_t payload_len,
-                                    uint16_t *frame_len)
+arachnae_status arachnae_frame_seal(uint8_t *frame, uint8_t dst, uint8_t src, uint16_t *frame_len)
 {
-    /* only `end` lives across the CRC call: on an 8-bit core one saved register pair, not five (issue 15) */
-    uint16_t n = (uint16_t)(ARACHNAE_FRAME_HEADER_SIZE + payload_len);
+    /* only `end` lives across the CRC call: one saved register pair on an 8-bit core (issue 15) */
+    uint16_t n = (uint16_t)(ARACHNAE_FRAME_HEADER_SIZE + frame[ARACHNAE_FRAME_LENGTH]);
     uint8_t *end = frame + n;
     uint16_t crc;
     *frame_len = (uint16_t)(n + ARACHNAE_FRAME_CRC_SIZE);
     frame[ARACHNAE_FRAME_DST] = dst;
     frame[ARACHNAE_FRAME_SRC] = src;
-    frame[ARACHNAE_FRAME_OPCODE] = opcode;
-    frame[ARACHNAE_FRAME_LENGTH] = payload_len;
     crc = arachnae_crc16(frame, n);
     /* the CRC travels big-endian after the payload (spec frame.byte_order) */
     end[0] = (uint8_t)(crc >> 8);
@@ -75,20 +72,19 @@ arachnae_status arachnae_frame_finish(uint8_t *frame, uint16_t cap, uint8_t dst,
 {
     if (cap < (uint16_t)(ARACHNAE_FRAME_OVERHEAD + payload_len))
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(opcode, dst, src, frame, payload_len, frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = opcode;
+    frame[ARACHNAE_FRAME_LENGTH] = payload_len;
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }
 
-arachnae_status arachnae_frame_check(const uint8_t *frame, uint16_t len, uint16_t own)
+/* CHECKSUM, ADDRESS, ROUTE of a frame whose length agrees with its length byte. Inlined into both
+ * callers: the parser's path (a node image) then has no call and no second length check (issue 15). */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline arachnae_status envelope(const uint8_t *frame, uint16_t len, uint16_t own)
 {
-    uint16_t need;
     uint8_t dst, own_lo = (uint8_t)(own & 0xFFu), own_hi = (uint8_t)(own >> 8);
-    if (len < ARACHNAE_FRAME_OVERHEAD)
-        return ARACHNAE_TRUNCATED;
-    need = (uint16_t)(ARACHNAE_FRAME_OVERHEAD + frame[ARACHNAE_FRAME_LENGTH]);
-    if (len < need)
-        return ARACHNAE_TRUNCATED;
-    if (len > need)
-        return ARACHNAE_OVERSIZE;
     /* MSB-first CRC without xorout: over a good frame with its big-endian CRC it gives 0 */
     if (arachnae_crc16(frame, len) != 0u)
         return ARACHNAE_CHECKSUM;
@@ -109,12 +105,27 @@ arachnae_status arachnae_frame_check(const uint8_t *frame, uint16_t len, uint16_
     return ARACHNAE_OK;
 }
 
-/* parser states; READY and HELD, the two with a valid frame, are the highest (one compare) */
-#define PS_RECEIVING 0u
+arachnae_status arachnae_frame_check(const uint8_t *frame, uint16_t len, uint16_t own)
+{
+    uint16_t need;
+    if (len < ARACHNAE_FRAME_OVERHEAD)
+        return ARACHNAE_TRUNCATED;
+    need = (uint16_t)(ARACHNAE_FRAME_OVERHEAD + frame[ARACHNAE_FRAME_LENGTH]);
+    if (len < need)
+        return ARACHNAE_TRUNCATED;
+    if (len > need)
+        return ARACHNAE_OVERSIZE;
+    return envelope(frame, len, own);
+}
+
+/* parser states; READY and HELD, the two with a valid frame, are the highest (one compare,
+ * arachnae_parser_frame() in arachnae.h) */
+#define PS_RECEIVING 0u  /* ARACHNAE_PARSER_INIT's state */
 #define PS_COMPLETE 1u  /* frame ended where its length byte said; verdict given */
 #define PS_DISCARD 2u   /* error reported; ignore bytes until the gap */
-#define PS_READY 3u     /* as COMPLETE, and the frame passed every check */
+#define PS_READY ARACHNAE_PARSER_READY     /* as COMPLETE, and the frame passed every check */
 #define PS_HELD 4u      /* READY frame after its gap: kept until the next byte */
+typedef char arachnae_parser_states_ok[(PS_HELD > PS_READY && PS_READY > PS_DISCARD) ? 1 : -1];
 
 void arachnae_parser_init(arachnae_parser *p, uint8_t *buf, uint16_t cap, uint16_t own,
                           arachnae_payload_check_fn check)
@@ -160,7 +171,7 @@ arachnae_status arachnae_parser_feed(arachnae_parser *p, uint8_t byte)
         return ARACHNAE_NONE;
     /* The whole frame is in: the CRC runs over it here, once. The next byte of the bus
      * comes only after the idle gap, so this loop (6 to 261 bytes) delays no byte. */
-    st = arachnae_frame_check(p->buf, n, p->own);
+    st = envelope(p->buf, n, p->own);   /* n == need: the length is right */
     if (st == ARACHNAE_OK && p->check != 0)
         st = p->check(p->buf[ARACHNAE_FRAME_OPCODE], p->buf + ARACHNAE_FRAME_PAYLOAD, p->buf[ARACHNAE_FRAME_LENGTH]);
     p->state = (st == ARACHNAE_OK) ? PS_READY : PS_COMPLETE;
@@ -177,12 +188,4 @@ arachnae_status arachnae_parser_gap(arachnae_parser *p)
         p->count = 0;
     }
     return st;
-}
-
-const uint8_t *arachnae_parser_frame(const arachnae_parser *p, uint16_t *len)
-{
-    if (p->state < PS_READY)   /* neither READY nor HELD */
-        return 0;
-    *len = p->count;
-    return p->buf;
 }

@@ -92,5 +92,7 @@ arachnae_status arachnae_data_build(const arachnae_data_t *m, uint8_t dst, uint8
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 5u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_DATA, dst, src, frame, arachnae_data_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_DATA;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_data_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }

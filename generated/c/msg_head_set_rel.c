@@ -72,5 +72,7 @@ arachnae_status arachnae_head_set_rel_build(const arachnae_head_set_rel_t *m, ui
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 2u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_HEAD_SET_REL, dst, src, frame, arachnae_head_set_rel_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_HEAD_SET_REL;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_head_set_rel_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }

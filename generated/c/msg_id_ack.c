@@ -71,5 +71,7 @@ arachnae_status arachnae_id_ack_build(const arachnae_id_ack_t *m, uint8_t dst, u
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 1u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_ID_ACK, dst, src, frame, arachnae_id_ack_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_ID_ACK;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_id_ack_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }

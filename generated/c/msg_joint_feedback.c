@@ -110,7 +110,9 @@ arachnae_status arachnae_joint_feedback_build(const arachnae_joint_feedback_t *m
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 8u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_JOINT_FEEDBACK, dst, src, frame, arachnae_joint_feedback_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_JOINT_FEEDBACK;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_joint_feedback_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }
 
 /* angle: phys = raw * 1/10 + 0 deg. Integer milli-units, rounding half away from zero (codegen/encoding.py). */

@@ -82,7 +82,9 @@ arachnae_status arachnae_joint_target_build(const arachnae_joint_target_t *m, ui
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 4u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_JOINT_TARGET, dst, src, frame, arachnae_joint_target_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_JOINT_TARGET;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_joint_target_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }
 
 /* angle: phys = raw * 1/10 + 0 deg. Integer milli-units, rounding half away from zero (codegen/encoding.py). */

@@ -88,5 +88,7 @@ arachnae_status arachnae_lcd_text_build(const arachnae_lcd_text_t *m, uint8_t ds
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + (uint16_t)(2u + m->length))
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_LCD_TEXT, dst, src, frame, arachnae_lcd_text_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_LCD_TEXT;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_lcd_text_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }

@@ -15,5 +15,7 @@ arachnae_status arachnae_leg_poll_build(uint8_t dst, uint8_t src, uint8_t *frame
 {
     if (cap < ARACHNAE_FRAME_OVERHEAD)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_LEG_POLL, dst, src, frame, 0u, frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_LEG_POLL;
+    frame[ARACHNAE_FRAME_LENGTH] = 0u;
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }

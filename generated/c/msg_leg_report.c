@@ -110,7 +110,9 @@ arachnae_status arachnae_leg_report_build(const arachnae_leg_report_t *m, uint8_
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 8u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_LEG_REPORT, dst, src, frame, arachnae_leg_report_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_LEG_REPORT;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_leg_report_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }
 
 /* x: phys = raw * 1/10 + 0 mm. Integer milli-units, rounding half away from zero (codegen/encoding.py). */

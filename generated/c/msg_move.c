@@ -79,5 +79,7 @@ arachnae_status arachnae_move_build(const arachnae_move_t *m, uint8_t dst, uint8
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 1u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_MOVE, dst, src, frame, arachnae_move_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_MOVE;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_move_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }

@@ -88,5 +88,7 @@ arachnae_status arachnae_move_relayed_build(const arachnae_move_relayed_t *m, ui
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 2u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_MOVE_RELAYED, dst, src, frame, arachnae_move_relayed_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_MOVE_RELAYED;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_move_relayed_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }

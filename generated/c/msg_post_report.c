@@ -87,5 +87,7 @@ arachnae_status arachnae_post_report_build(const arachnae_post_report_t *m, uint
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + (uint16_t)(1u + m->missing_count))
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_POST_REPORT, dst, src, frame, arachnae_post_report_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_POST_REPORT;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_post_report_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }

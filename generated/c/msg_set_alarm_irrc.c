@@ -66,7 +66,9 @@ arachnae_status arachnae_set_alarm_irrc_build(const arachnae_set_alarm_irrc_t *m
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 1u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_SET_ALARM_IRRC, dst, src, frame, arachnae_set_alarm_irrc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_SET_ALARM_IRRC;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_set_alarm_irrc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }
 
 /* limit: phys = raw * 2/51 + 0 cm. Integer milli-units, rounding half away from zero (codegen/encoding.py). */

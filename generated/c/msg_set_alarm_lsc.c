@@ -71,7 +71,9 @@ arachnae_status arachnae_set_alarm_lsc_build(const arachnae_set_alarm_lsc_t *m, 
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 1u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_SET_ALARM_LSC, dst, src, frame, arachnae_set_alarm_lsc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_SET_ALARM_LSC;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_set_alarm_lsc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }
 
 /* limit: raw = 64 * log10(phys / 1/10) lx, table 1. Integer milli-units, rounding half away from zero (codegen/encoding.py). */

@@ -80,5 +80,7 @@ arachnae_status arachnae_set_alarm_tsc_build(const arachnae_set_alarm_tsc_t *m, 
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 2u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_SET_ALARM_TSC, dst, src, frame, arachnae_set_alarm_tsc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_SET_ALARM_TSC;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_set_alarm_tsc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }

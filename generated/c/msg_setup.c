@@ -83,5 +83,7 @@ arachnae_status arachnae_setup_build(const arachnae_setup_t *m, uint8_t dst, uin
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 3u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_SETUP, dst, src, frame, arachnae_setup_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_SETUP;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_setup_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }

@@ -81,5 +81,7 @@ arachnae_status arachnae_speak_build(const arachnae_speak_t *m, uint8_t dst, uin
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + (uint16_t)(2u + m->length))
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_SPEAK, dst, src, frame, arachnae_speak_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_SPEAK;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_speak_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }

@@ -82,5 +82,7 @@ arachnae_status arachnae_speak_resident_build(const arachnae_speak_resident_t *m
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 3u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_SPEAK_RESIDENT, dst, src, frame, arachnae_speak_resident_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_SPEAK_RESIDENT;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_speak_resident_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }

@@ -96,5 +96,7 @@ arachnae_status arachnae_status_ack_mmc_build(const arachnae_status_ack_mmc_t *m
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 2u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_STATUS_ACK_MMC, dst, src, frame, arachnae_status_ack_mmc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_STATUS_ACK_MMC;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_status_ack_mmc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }

@@ -71,5 +71,7 @@ arachnae_status arachnae_status_ack_order_build(const arachnae_status_ack_order_
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 1u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_STATUS_ACK_ORDER, dst, src, frame, arachnae_status_ack_order_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_STATUS_ACK_ORDER;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_status_ack_order_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }

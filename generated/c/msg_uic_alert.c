@@ -71,5 +71,7 @@ arachnae_status arachnae_uic_alert_build(const arachnae_uic_alert_t *m, uint8_t 
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 1u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_UIC_ALERT, dst, src, frame, arachnae_uic_alert_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_UIC_ALERT;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_uic_alert_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }

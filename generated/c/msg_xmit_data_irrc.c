@@ -70,7 +70,9 @@ arachnae_status arachnae_xmit_data_irrc_build(const arachnae_xmit_data_irrc_t *m
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 3u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_XMIT_DATA_IRRC, dst, src, frame, arachnae_xmit_data_irrc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_XMIT_DATA_IRRC;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_xmit_data_irrc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }
 
 /* left: phys = raw * 2/51 + 0 cm. Integer milli-units, rounding half away from zero (codegen/encoding.py). */

@@ -80,5 +80,7 @@ arachnae_status arachnae_xmit_data_isc_build(const arachnae_xmit_data_isc_t *m, 
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 2u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_XMIT_DATA_ISC, dst, src, frame, arachnae_xmit_data_isc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_XMIT_DATA_ISC;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_xmit_data_isc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }

@@ -71,7 +71,9 @@ arachnae_status arachnae_xmit_data_psc_build(const arachnae_xmit_data_psc_t *m, 
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 1u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_XMIT_DATA_PSC, dst, src, frame, arachnae_xmit_data_psc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_XMIT_DATA_PSC;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_xmit_data_psc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }
 
 /* voltage: phys = raw * 1/200 + 4 V. Integer milli-units, rounding half away from zero (codegen/encoding.py). */

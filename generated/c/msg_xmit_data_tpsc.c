@@ -71,5 +71,7 @@ arachnae_status arachnae_xmit_data_tpsc_build(const arachnae_xmit_data_tpsc_t *m
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 1u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_XMIT_DATA_TPSC, dst, src, frame, arachnae_xmit_data_tpsc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_XMIT_DATA_TPSC;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_xmit_data_tpsc_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }

@@ -101,5 +101,7 @@ arachnae_status arachnae_xmit_record_build(const arachnae_xmit_record_t *m, uint
         return st;
     if (cap < ARACHNAE_FRAME_OVERHEAD + 6u)
         return ARACHNAE_BUFFER;
-    return arachnae_frame_seal(ARACHNAE_OP_XMIT_RECORD, dst, src, frame, arachnae_xmit_record_pack(m, frame + ARACHNAE_FRAME_PAYLOAD), frame_len);
+    frame[ARACHNAE_FRAME_OPCODE] = ARACHNAE_OP_XMIT_RECORD;
+    frame[ARACHNAE_FRAME_LENGTH] = arachnae_xmit_record_pack(m, frame + ARACHNAE_FRAME_PAYLOAD);
+    return arachnae_frame_seal(frame, dst, src, frame_len);
 }

@@ -11,9 +11,6 @@ arachnae_status lcp_node_init(lcp_node *node, uint8_t address, void *user)
         return ARACHNAE_ADDRESS;
     node->address = address;
     node->user = user;
-    node->unhandled.count = 0;
-    node->unhandled.opcode = 0;
-    node->unhandled.status = ARACHNAE_OK;
     return ARACHNAE_OK;
 }
 
@@ -39,25 +36,27 @@ arachnae_status lcp_payload_check(uint8_t opcode, const uint8_t *payload, uint8_
     }
 }
 
-/* A frame for us whose payload passed lcp_payload_check: call its callback, or
- * build and send the reply to a request (one reply buffer, one seal and one send for all of them:
- * each reply is checked and packed, never built through its _build, issue 15). */
-static arachnae_status deliver(lcp_node *node, const arachnae_header *h, const uint8_t *payload)
+/* A frame the parser passed with own = node->address and lcp_payload_check (feed() said OK):
+ * envelope and payload are checked once, there, not again here (issue 15). Calls its callback, or
+ * builds and sends the reply to a request (one reply buffer, one seal and one send for all of them:
+ * each reply is checked and packed, never built through its _build). */
+arachnae_status lcp_dispatch(lcp_node *node, const uint8_t *frame)
 {
+    arachnae_header *h = &node->rx;
+    const uint8_t *payload = frame + ARACHNAE_FRAME_PAYLOAD;
     arachnae_status st;
     uint8_t op, n;
+    arachnae_frame_header(frame, h);
     switch (h->opcode) {
     case ARACHNAE_OP_INIT:
         lcp_on_init(node, h);
         return ARACHNAE_OK;
     case ARACHNAE_OP_ID_REQ:
-        /* seed 3.2.2: ID_ACK carries the node's own address */
-        node->msg.reply_id_ack.address = node->address;
-        st = arachnae_id_ack_check(&node->msg.reply_id_ack);
-        if (st != ARACHNAE_OK)
-            return st;
+        /* seed 3.2.2: ID_ACK carries the node's own address, its one byte (codegen checks the layout);
+         * no RANGE check: lcp_node_init took only the role's addresses, every one a node */
+        node->out[ARACHNAE_FRAME_PAYLOAD] = node->address;
         op = ARACHNAE_OP_ID_ACK;
-        n = arachnae_id_ack_pack(&node->msg.reply_id_ack, node->out + ARACHNAE_FRAME_PAYLOAD);
+        n = 1u;
         break;
     case ARACHNAE_OP_STATUS_REQ:
         /* seed 3.2.10: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_ORDER) */
@@ -69,45 +68,51 @@ static arachnae_status deliver(lcp_node *node, const arachnae_header *h, const u
         op = ARACHNAE_OP_STATUS_ACK_ORDER;
         n = arachnae_status_ack_order_pack(&node->msg.reply_status, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
-    case ARACHNAE_OP_ID_ACK:
-        arachnae_id_ack_unpack(payload, h->length, &node->msg.rx_id_ack);
+    case ARACHNAE_OP_ID_ACK: {
+        /* arachnae_id_ack_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_id_ack.address = (uint8_t)((unsigned)payload[0]);
         lcp_on_id_ack(node, h, &node->msg.rx_id_ack);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_STATUS_ACK_ORDER:
-        arachnae_status_ack_order_unpack(payload, h->length, &node->msg.rx_status_ack_order);
+    }
+    case ARACHNAE_OP_STATUS_ACK_ORDER: {
+        /* arachnae_status_ack_order_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_status_ack_order.status = (uint8_t)((unsigned)payload[0]);
         lcp_on_status_ack_order(node, h, &node->msg.rx_status_ack_order);
         return ARACHNAE_OK;
+    }
     case ARACHNAE_OP_POST_QUERY:
         lcp_on_post_query(node, h);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_LEG_TARGET:
-        arachnae_leg_target_unpack(payload, h->length, &node->msg.rx_leg_target);
+    case ARACHNAE_OP_LEG_TARGET: {
+        /* arachnae_leg_target_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_leg_target.phase = (uint8_t)((unsigned)payload[0]);
+        node->msg.rx_leg_target.x = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[1] << 8) | (unsigned)payload[2]), 0x8000u, 0xFFFFu);
+        node->msg.rx_leg_target.y = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[3] << 8) | (unsigned)payload[4]), 0x8000u, 0xFFFFu);
+        node->msg.rx_leg_target.z = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[5] << 8) | (unsigned)payload[6]), 0x8000u, 0xFFFFu);
+        node->msg.rx_leg_target.duration = (uint16_t)(((unsigned)payload[7] << 8) | (unsigned)payload[8]);
         lcp_on_leg_target(node, h, &node->msg.rx_leg_target);
         return ARACHNAE_OK;
+    }
     case ARACHNAE_OP_LEG_POLL:
         lcp_on_leg_poll(node, h);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_JOINT_FEEDBACK:
-        arachnae_joint_feedback_unpack(payload, h->length, &node->msg.rx_joint_feedback);
+    case ARACHNAE_OP_JOINT_FEEDBACK: {
+        /* arachnae_joint_feedback_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_joint_feedback.angle = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[0] << 8) | (unsigned)payload[1]), 0x8000u, 0xFFFFu);
+        node->msg.rx_joint_feedback.speed = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[2] << 8) | (unsigned)payload[3]), 0x8000u, 0xFFFFu);
+        node->msg.rx_joint_feedback.current = (uint16_t)(((unsigned)payload[4] << 8) | (unsigned)payload[5]);
+        node->msg.rx_joint_feedback.temperature = (int8_t)arachnae_sext((uint16_t)((unsigned)payload[6]), 0x80u, 0xFFu);
+        node->msg.rx_joint_feedback.flags = (uint8_t)((unsigned)payload[7]);
         lcp_on_joint_feedback(node, h, &node->msg.rx_joint_feedback);
         return ARACHNAE_OK;
-    default:
-        return ARACHNAE_OK;
+    }
+    default:   /* not reached: the payload check refused every other opcode */
+        return ARACHNAE_OPCODE;
     }
     /* node->out holds the largest reply of this role (node_lcp.h), so it fits */
-    (void)arachnae_frame_seal(op, h->src, node->address, node->out, n, &node->out_len);
+    node->out[ARACHNAE_FRAME_OPCODE] = op;
+    node->out[ARACHNAE_FRAME_LENGTH] = n;
+    (void)arachnae_frame_seal(node->out, h->src, node->address, &node->out_len);
     lcp_send(node, node->out, node->out_len);
     return ARACHNAE_OK;
-}
-
-arachnae_status lcp_dispatch(lcp_node *node, const uint8_t *frame, uint16_t len)
-{
-    arachnae_status st = arachnae_frame_check(frame, len, node->address);
-    if (st != ARACHNAE_OK)
-        return st;
-    arachnae_frame_header(frame, &node->rx);
-    st = lcp_payload_check(node->rx.opcode, frame + ARACHNAE_FRAME_PAYLOAD, node->rx.length);
-    if (st == ARACHNAE_OK)
-        st = deliver(node, &node->rx, frame + ARACHNAE_FRAME_PAYLOAD);
-    return arachnae_unhandled_note(&node->unhandled, node->rx.opcode, st);
 }

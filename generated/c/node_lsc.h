@@ -10,21 +10,17 @@
  * functions under "defined by the behaviour"; regeneration never touches it.
  * Use: arachnae_parser_init(&parser, buf, ARACHNAE_RX_MAX_LSC, node.address,
  * lsc_payload_check) in the UART RX path; when feed() returns ARACHNAE_OK,
- * pass arachnae_parser_frame() to lsc_dispatch() from the main loop.
+ * pass arachnae_parser_frame() (or a copy of it) to lsc_dispatch() from the main loop.
  */
 #include "arachnae.h"
 
 typedef struct lsc_node {
     uint8_t address; /* own address */
     void *user;      /* the behaviour's state */
-    /* checked frames for this node that reached no callback: an opcode the role does not
-     * receive, a bad payload, a reply that could not be built */
-    arachnae_unhandled unhandled;
     /* the skeleton's working space during lsc_dispatch(): here, not on the stack, so the
      * dispatch needs no stack frame (issue 15); callbacks get &rx as their header */
     arachnae_header rx;
     union {
-        arachnae_id_ack_t reply_id_ack;
         arachnae_status_ack_order_t reply_status;
         arachnae_set_alarm_lsc_t rx_set_alarm_lsc;
     } msg;  /* the reply being built, or the message being delivered */
@@ -36,10 +32,12 @@ typedef struct lsc_node {
 arachnae_status lsc_node_init(lsc_node *node, uint8_t address, void *user);
 /* OPCODE for what this role does not receive, else LENGTH/RANGE of the payload. */
 arachnae_status lsc_payload_check(uint8_t opcode, const uint8_t *payload, uint8_t len);
-/* Checks a whole frame (shared order, own address), decodes it and calls the callback.
- * Requests sent to broadcast get no reply (every node answering would collide on the bus).
- * A checked frame that reaches no callback is counted in node->unhandled. */
-arachnae_status lsc_dispatch(lsc_node *node, const uint8_t *frame, uint16_t len);
+/* Delivers a frame the parser accepted (feed() returned ARACHNAE_OK; parser initialised with
+ * own = node->address and lsc_payload_check): decodes it without checking again and calls the
+ * callback, or answers the request. Requests sent to broadcast get no reply (every node answering
+ * would collide on the bus). Returns OK, or the status of a reply that could not be sent (RANGE: the
+ * behaviour's STATUS_ACK out of range); the caller counts it (issue 10: never dropped silently). */
+arachnae_status lsc_dispatch(lsc_node *node, const uint8_t *frame);
 
 /* ---- defined by the behaviour ---- */
 /* Transmit one complete frame (driver enable, UART TX, driver disable). */

@@ -11,9 +11,6 @@ arachnae_status mcp_node_init(mcp_node *node, uint8_t address, void *user)
         return ARACHNAE_ADDRESS;
     node->address = address;
     node->user = user;
-    node->unhandled.count = 0;
-    node->unhandled.opcode = 0;
-    node->unhandled.status = ARACHNAE_OK;
     return ARACHNAE_OK;
 }
 
@@ -40,55 +37,70 @@ arachnae_status mcp_payload_check(uint8_t opcode, const uint8_t *payload, uint8_
     }
 }
 
-/* A frame for us whose payload passed mcp_payload_check: call its callback, or
- * build and send the reply to a request (one reply buffer, one seal and one send for all of them:
- * each reply is checked and packed, never built through its _build, issue 15). */
-static arachnae_status deliver(mcp_node *node, const arachnae_header *h, const uint8_t *payload)
+/* A frame the parser passed with own = node->address and mcp_payload_check (feed() said OK):
+ * envelope and payload are checked once, there, not again here (issue 15). Calls its callback, or
+ * builds and sends the reply to a request (one reply buffer, one seal and one send for all of them:
+ * each reply is checked and packed, never built through its _build). */
+arachnae_status mcp_dispatch(mcp_node *node, const uint8_t *frame)
 {
+    arachnae_header *h = &node->rx;
+    const uint8_t *payload = frame + ARACHNAE_FRAME_PAYLOAD;
+    arachnae_frame_header(frame, h);
     switch (h->opcode) {
-    case ARACHNAE_OP_ID_ACK:
-        arachnae_id_ack_unpack(payload, h->length, &node->msg.rx_id_ack);
+    case ARACHNAE_OP_ID_ACK: {
+        /* arachnae_id_ack_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_id_ack.address = (uint8_t)((unsigned)payload[0]);
         mcp_on_id_ack(node, h, &node->msg.rx_id_ack);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_STATUS_ACK_BUSY:
-        arachnae_status_ack_busy_unpack(payload, h->length, &node->msg.rx_status_ack_busy);
+    }
+    case ARACHNAE_OP_STATUS_ACK_BUSY: {
+        /* arachnae_status_ack_busy_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_status_ack_busy.status = (uint8_t)((unsigned)payload[0]);
         mcp_on_status_ack_busy(node, h, &node->msg.rx_status_ack_busy);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_STATUS_ACK_MMC:
-        arachnae_status_ack_mmc_unpack(payload, h->length, &node->msg.rx_status_ack_mmc);
+    }
+    case ARACHNAE_OP_STATUS_ACK_MMC: {
+        /* arachnae_status_ack_mmc_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_status_ack_mmc.gait = (uint8_t)((((unsigned)payload[0] >> 4) & 0x0Fu));
+        node->msg.rx_status_ack_mmc.direction = (uint8_t)(((unsigned)payload[0] & 0x0Fu));
+        node->msg.rx_status_ack_mmc.leg = (uint8_t)((((unsigned)payload[1] >> 4) & 0x0Fu));
+        node->msg.rx_status_ack_mmc.error = (uint8_t)(((unsigned)payload[1] & 0x0Fu));
         mcp_on_status_ack_mmc(node, h, &node->msg.rx_status_ack_mmc);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_POST_REPORT:
-        arachnae_post_report_unpack(payload, h->length, &node->msg.rx_post_report);
+    }
+    case ARACHNAE_OP_POST_REPORT: {
+        /* arachnae_post_report_unpack, inlined: one call less per message (issue 15) */
+        uint16_t i;
+        node->msg.rx_post_report.missing_count = (uint8_t)((unsigned)payload[0]);
+        for (i = 0; i < (uint16_t)(h->length - 1u); i++)
+            node->msg.rx_post_report.missing[i] = payload[1u + i];
         mcp_on_post_report(node, h, &node->msg.rx_post_report);
         return ARACHNAE_OK;
+    }
     case ARACHNAE_OP_POST_REQ:
         mcp_on_post_req(node, h);
         return ARACHNAE_OK;
     case ARACHNAE_OP_XMIT_REQ:
         mcp_on_xmit_req(node, h);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_XMIT_RECORD:
-        arachnae_xmit_record_unpack(payload, h->length, &node->msg.rx_xmit_record);
+    case ARACHNAE_OP_XMIT_RECORD: {
+        /* arachnae_xmit_record_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_xmit_record.target = (uint8_t)((unsigned)payload[0]);
+        node->msg.rx_xmit_record.source = (uint8_t)((unsigned)payload[1]);
+        node->msg.rx_xmit_record.kind = (uint8_t)((unsigned)payload[2]);
+        node->msg.rx_xmit_record.channel = (uint16_t)(((unsigned)payload[3] << 8) | (unsigned)payload[4]);
+        node->msg.rx_xmit_record.value = (uint8_t)((unsigned)payload[5]);
         mcp_on_xmit_record(node, h, &node->msg.rx_xmit_record);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_MOVE:
-        arachnae_move_unpack(payload, h->length, &node->msg.rx_move);
+    }
+    case ARACHNAE_OP_MOVE: {
+        /* arachnae_move_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_move.mov_cmd = (uint8_t)((((unsigned)payload[0] >> 4) & 0x0Fu));
+        node->msg.rx_move.param = (uint8_t)(((unsigned)payload[0] & 0x0Fu));
         mcp_on_move(node, h, &node->msg.rx_move);
         return ARACHNAE_OK;
-    default:
-        return ARACHNAE_OK;
     }
-}
-
-arachnae_status mcp_dispatch(mcp_node *node, const uint8_t *frame, uint16_t len)
-{
-    arachnae_status st = arachnae_frame_check(frame, len, node->address);
-    if (st != ARACHNAE_OK)
-        return st;
-    arachnae_frame_header(frame, &node->rx);
-    st = mcp_payload_check(node->rx.opcode, frame + ARACHNAE_FRAME_PAYLOAD, node->rx.length);
-    if (st == ARACHNAE_OK)
-        st = deliver(node, &node->rx, frame + ARACHNAE_FRAME_PAYLOAD);
-    return arachnae_unhandled_note(&node->unhandled, node->rx.opcode, st);
+    default:   /* not reached: the payload check refused every other opcode */
+        return ARACHNAE_OPCODE;
+    }
 }

@@ -11,9 +11,6 @@ arachnae_status mmc_node_init(mmc_node *node, uint8_t address, void *user)
         return ARACHNAE_ADDRESS;
     node->address = address;
     node->user = user;
-    node->unhandled.count = 0;
-    node->unhandled.opcode = 0;
-    node->unhandled.status = ARACHNAE_OK;
     return ARACHNAE_OK;
 }
 
@@ -40,25 +37,27 @@ arachnae_status mmc_payload_check(uint8_t opcode, const uint8_t *payload, uint8_
     }
 }
 
-/* A frame for us whose payload passed mmc_payload_check: call its callback, or
- * build and send the reply to a request (one reply buffer, one seal and one send for all of them:
- * each reply is checked and packed, never built through its _build, issue 15). */
-static arachnae_status deliver(mmc_node *node, const arachnae_header *h, const uint8_t *payload)
+/* A frame the parser passed with own = node->address and mmc_payload_check (feed() said OK):
+ * envelope and payload are checked once, there, not again here (issue 15). Calls its callback, or
+ * builds and sends the reply to a request (one reply buffer, one seal and one send for all of them:
+ * each reply is checked and packed, never built through its _build). */
+arachnae_status mmc_dispatch(mmc_node *node, const uint8_t *frame)
 {
+    arachnae_header *h = &node->rx;
+    const uint8_t *payload = frame + ARACHNAE_FRAME_PAYLOAD;
     arachnae_status st;
     uint8_t op, n;
+    arachnae_frame_header(frame, h);
     switch (h->opcode) {
     case ARACHNAE_OP_INIT:
         mmc_on_init(node, h);
         return ARACHNAE_OK;
     case ARACHNAE_OP_ID_REQ:
-        /* seed 3.2.2: ID_ACK carries the node's own address */
-        node->msg.reply_id_ack.address = node->address;
-        st = arachnae_id_ack_check(&node->msg.reply_id_ack);
-        if (st != ARACHNAE_OK)
-            return st;
+        /* seed 3.2.2: ID_ACK carries the node's own address, its one byte (codegen checks the layout);
+         * no RANGE check: mmc_node_init took only the role's addresses, every one a node */
+        node->out[ARACHNAE_FRAME_PAYLOAD] = node->address;
         op = ARACHNAE_OP_ID_ACK;
-        n = arachnae_id_ack_pack(&node->msg.reply_id_ack, node->out + ARACHNAE_FRAME_PAYLOAD);
+        n = 1u;
         break;
     case ARACHNAE_OP_STATUS_REQ:
         /* seed 3.2.4: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_MMC) */
@@ -73,46 +72,55 @@ static arachnae_status deliver(mmc_node *node, const arachnae_header *h, const u
         op = ARACHNAE_OP_STATUS_ACK_MMC;
         n = arachnae_status_ack_mmc_pack(&node->msg.reply_status, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
-    case ARACHNAE_OP_ID_ACK:
-        arachnae_id_ack_unpack(payload, h->length, &node->msg.rx_id_ack);
+    case ARACHNAE_OP_ID_ACK: {
+        /* arachnae_id_ack_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_id_ack.address = (uint8_t)((unsigned)payload[0]);
         mmc_on_id_ack(node, h, &node->msg.rx_id_ack);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_STATUS_ACK_ORDER:
-        arachnae_status_ack_order_unpack(payload, h->length, &node->msg.rx_status_ack_order);
+    }
+    case ARACHNAE_OP_STATUS_ACK_ORDER: {
+        /* arachnae_status_ack_order_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_status_ack_order.status = (uint8_t)((unsigned)payload[0]);
         mmc_on_status_ack_order(node, h, &node->msg.rx_status_ack_order);
         return ARACHNAE_OK;
+    }
     case ARACHNAE_OP_POST_QUERY:
         mmc_on_post_query(node, h);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_POST_REPORT:
-        arachnae_post_report_unpack(payload, h->length, &node->msg.rx_post_report);
+    case ARACHNAE_OP_POST_REPORT: {
+        /* arachnae_post_report_unpack, inlined: one call less per message (issue 15) */
+        uint16_t i;
+        node->msg.rx_post_report.missing_count = (uint8_t)((unsigned)payload[0]);
+        for (i = 0; i < (uint16_t)(h->length - 1u); i++)
+            node->msg.rx_post_report.missing[i] = payload[1u + i];
         mmc_on_post_report(node, h, &node->msg.rx_post_report);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_MOVE_RELAYED:
-        arachnae_move_relayed_unpack(payload, h->length, &node->msg.rx_move_relayed);
+    }
+    case ARACHNAE_OP_MOVE_RELAYED: {
+        /* arachnae_move_relayed_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_move_relayed.address = (uint8_t)((unsigned)payload[0]);
+        node->msg.rx_move_relayed.mov_cmd = (uint8_t)((((unsigned)payload[1] >> 4) & 0x0Fu));
+        node->msg.rx_move_relayed.param = (uint8_t)(((unsigned)payload[1] & 0x0Fu));
         mmc_on_move_relayed(node, h, &node->msg.rx_move_relayed);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_LEG_REPORT:
-        arachnae_leg_report_unpack(payload, h->length, &node->msg.rx_leg_report);
+    }
+    case ARACHNAE_OP_LEG_REPORT: {
+        /* arachnae_leg_report_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_leg_report.flags = (uint8_t)((unsigned)payload[0]);
+        node->msg.rx_leg_report.x = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[1] << 8) | (unsigned)payload[2]), 0x8000u, 0xFFFFu);
+        node->msg.rx_leg_report.y = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[3] << 8) | (unsigned)payload[4]), 0x8000u, 0xFFFFu);
+        node->msg.rx_leg_report.z = (int16_t)arachnae_sext((uint16_t)(((unsigned)payload[5] << 8) | (unsigned)payload[6]), 0x8000u, 0xFFFFu);
+        node->msg.rx_leg_report.servo_temp = (int8_t)arachnae_sext((uint16_t)((unsigned)payload[7]), 0x80u, 0xFFu);
         mmc_on_leg_report(node, h, &node->msg.rx_leg_report);
         return ARACHNAE_OK;
-    default:
-        return ARACHNAE_OK;
+    }
+    default:   /* not reached: the payload check refused every other opcode */
+        return ARACHNAE_OPCODE;
     }
     /* node->out holds the largest reply of this role (node_mmc.h), so it fits */
-    (void)arachnae_frame_seal(op, h->src, node->address, node->out, n, &node->out_len);
+    node->out[ARACHNAE_FRAME_OPCODE] = op;
+    node->out[ARACHNAE_FRAME_LENGTH] = n;
+    (void)arachnae_frame_seal(node->out, h->src, node->address, &node->out_len);
     mmc_send(node, node->out, node->out_len);
     return ARACHNAE_OK;
-}
-
-arachnae_status mmc_dispatch(mmc_node *node, const uint8_t *frame, uint16_t len)
-{
-    arachnae_status st = arachnae_frame_check(frame, len, node->address);
-    if (st != ARACHNAE_OK)
-        return st;
-    arachnae_frame_header(frame, &node->rx);
-    st = mmc_payload_check(node->rx.opcode, frame + ARACHNAE_FRAME_PAYLOAD, node->rx.length);
-    if (st == ARACHNAE_OK)
-        st = deliver(node, &node->rx, frame + ARACHNAE_FRAME_PAYLOAD);
-    return arachnae_unhandled_note(&node->unhandled, node->rx.opcode, st);
 }

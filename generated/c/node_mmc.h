@@ -10,21 +10,17 @@
  * functions under "defined by the behaviour"; regeneration never touches it.
  * Use: arachnae_parser_init(&parser, buf, ARACHNAE_RX_MAX_MMC, node.address,
  * mmc_payload_check) in the UART RX path; when feed() returns ARACHNAE_OK,
- * pass arachnae_parser_frame() to mmc_dispatch() from the main loop.
+ * pass arachnae_parser_frame() (or a copy of it) to mmc_dispatch() from the main loop.
  */
 #include "arachnae.h"
 
 typedef struct mmc_node {
     uint8_t address; /* own address */
     void *user;      /* the behaviour's state */
-    /* checked frames for this node that reached no callback: an opcode the role does not
-     * receive, a bad payload, a reply that could not be built */
-    arachnae_unhandled unhandled;
     /* the skeleton's working space during mmc_dispatch(): here, not on the stack, so the
      * dispatch needs no stack frame (issue 15); callbacks get &rx as their header */
     arachnae_header rx;
     union {
-        arachnae_id_ack_t reply_id_ack;
         arachnae_status_ack_mmc_t reply_status;
         arachnae_id_ack_t rx_id_ack;
         arachnae_status_ack_order_t rx_status_ack_order;
@@ -40,10 +36,12 @@ typedef struct mmc_node {
 arachnae_status mmc_node_init(mmc_node *node, uint8_t address, void *user);
 /* OPCODE for what this role does not receive, else LENGTH/RANGE of the payload. */
 arachnae_status mmc_payload_check(uint8_t opcode, const uint8_t *payload, uint8_t len);
-/* Checks a whole frame (shared order, own address), decodes it and calls the callback.
- * Requests sent to broadcast get no reply (every node answering would collide on the bus).
- * A checked frame that reaches no callback is counted in node->unhandled. */
-arachnae_status mmc_dispatch(mmc_node *node, const uint8_t *frame, uint16_t len);
+/* Delivers a frame the parser accepted (feed() returned ARACHNAE_OK; parser initialised with
+ * own = node->address and mmc_payload_check): decodes it without checking again and calls the
+ * callback, or answers the request. Requests sent to broadcast get no reply (every node answering
+ * would collide on the bus). Returns OK, or the status of a reply that could not be sent (RANGE: the
+ * behaviour's STATUS_ACK out of range); the caller counts it (issue 10: never dropped silently). */
+arachnae_status mmc_dispatch(mmc_node *node, const uint8_t *frame);
 
 /* ---- defined by the behaviour ---- */
 /* Transmit one complete frame (driver enable, UART TX, driver disable). */

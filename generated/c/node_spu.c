@@ -11,9 +11,6 @@ arachnae_status spu_node_init(spu_node *node, uint8_t address, void *user)
         return ARACHNAE_ADDRESS;
     node->address = address;
     node->user = user;
-    node->unhandled.count = 0;
-    node->unhandled.opcode = 0;
-    node->unhandled.status = ARACHNAE_OK;
     return ARACHNAE_OK;
 }
 
@@ -55,25 +52,27 @@ arachnae_status spu_payload_check(uint8_t opcode, const uint8_t *payload, uint8_
     }
 }
 
-/* A frame for us whose payload passed spu_payload_check: call its callback, or
- * build and send the reply to a request (one reply buffer, one seal and one send for all of them:
- * each reply is checked and packed, never built through its _build, issue 15). */
-static arachnae_status deliver(spu_node *node, const arachnae_header *h, const uint8_t *payload)
+/* A frame the parser passed with own = node->address and spu_payload_check (feed() said OK):
+ * envelope and payload are checked once, there, not again here (issue 15). Calls its callback, or
+ * builds and sends the reply to a request (one reply buffer, one seal and one send for all of them:
+ * each reply is checked and packed, never built through its _build). */
+arachnae_status spu_dispatch(spu_node *node, const uint8_t *frame)
 {
+    arachnae_header *h = &node->rx;
+    const uint8_t *payload = frame + ARACHNAE_FRAME_PAYLOAD;
     arachnae_status st;
     uint8_t op, n;
+    arachnae_frame_header(frame, h);
     switch (h->opcode) {
     case ARACHNAE_OP_INIT:
         spu_on_init(node, h);
         return ARACHNAE_OK;
     case ARACHNAE_OP_ID_REQ:
-        /* seed 3.2.2: ID_ACK carries the node's own address */
-        node->msg.reply_id_ack.address = node->address;
-        st = arachnae_id_ack_check(&node->msg.reply_id_ack);
-        if (st != ARACHNAE_OK)
-            return st;
+        /* seed 3.2.2: ID_ACK carries the node's own address, its one byte (codegen checks the layout);
+         * no RANGE check: spu_node_init took only the role's addresses, every one a node */
+        node->out[ARACHNAE_FRAME_PAYLOAD] = node->address;
         op = ARACHNAE_OP_ID_ACK;
-        n = arachnae_id_ack_pack(&node->msg.reply_id_ack, node->out + ARACHNAE_FRAME_PAYLOAD);
+        n = 1u;
         break;
     case ARACHNAE_OP_STATUS_REQ:
         /* seed 3.2.3: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_BUSY) */
@@ -85,18 +84,24 @@ static arachnae_status deliver(spu_node *node, const arachnae_header *h, const u
         op = ARACHNAE_OP_STATUS_ACK_BUSY;
         n = arachnae_status_ack_busy_pack(&node->msg.reply_status, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
-    case ARACHNAE_OP_ID_ACK:
-        arachnae_id_ack_unpack(payload, h->length, &node->msg.rx_id_ack);
+    case ARACHNAE_OP_ID_ACK: {
+        /* arachnae_id_ack_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_id_ack.address = (uint8_t)((unsigned)payload[0]);
         spu_on_id_ack(node, h, &node->msg.rx_id_ack);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_STATUS_ACK_ORDER:
-        arachnae_status_ack_order_unpack(payload, h->length, &node->msg.rx_status_ack_order);
+    }
+    case ARACHNAE_OP_STATUS_ACK_ORDER: {
+        /* arachnae_status_ack_order_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_status_ack_order.status = (uint8_t)((unsigned)payload[0]);
         spu_on_status_ack_order(node, h, &node->msg.rx_status_ack_order);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_STATUS_ACK_RANGE:
-        arachnae_status_ack_range_unpack(payload, h->length, &node->msg.rx_status_ack_range);
+    }
+    case ARACHNAE_OP_STATUS_ACK_RANGE: {
+        /* arachnae_status_ack_range_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_status_ack_range.status = (uint8_t)((unsigned)payload[0]);
         spu_on_status_ack_range(node, h, &node->msg.rx_status_ack_range);
         return ARACHNAE_OK;
+    }
     case ARACHNAE_OP_POST_QUERY:
         spu_on_post_query(node, h);
         return ARACHNAE_OK;
@@ -115,51 +120,60 @@ static arachnae_status deliver(spu_node *node, const arachnae_header *h, const u
     case ARACHNAE_OP_OBJ_BOTH:
         spu_on_obj_both(node, h);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_XMIT_DATA_USRC:
-        arachnae_xmit_data_usrc_unpack(payload, h->length, &node->msg.rx_xmit_data_usrc);
+    case ARACHNAE_OP_XMIT_DATA_USRC: {
+        /* arachnae_xmit_data_usrc_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_xmit_data_usrc.distance = (uint8_t)((unsigned)payload[0]);
+        node->msg.rx_xmit_data_usrc.angle = (uint16_t)(((unsigned)payload[1] << 8) | (unsigned)payload[2]);
         spu_on_xmit_data_usrc(node, h, &node->msg.rx_xmit_data_usrc);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_XMIT_DATA_TPSC:
-        arachnae_xmit_data_tpsc_unpack(payload, h->length, &node->msg.rx_xmit_data_tpsc);
+    }
+    case ARACHNAE_OP_XMIT_DATA_TPSC: {
+        /* arachnae_xmit_data_tpsc_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_xmit_data_tpsc.contact = (uint8_t)((unsigned)payload[0]);
         spu_on_xmit_data_tpsc(node, h, &node->msg.rx_xmit_data_tpsc);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_XMIT_DATA_IRRC:
-        arachnae_xmit_data_irrc_unpack(payload, h->length, &node->msg.rx_xmit_data_irrc);
+    }
+    case ARACHNAE_OP_XMIT_DATA_IRRC: {
+        /* arachnae_xmit_data_irrc_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_xmit_data_irrc.left = (uint8_t)((unsigned)payload[0]);
+        node->msg.rx_xmit_data_irrc.center = (uint8_t)((unsigned)payload[1]);
+        node->msg.rx_xmit_data_irrc.right = (uint8_t)((unsigned)payload[2]);
         spu_on_xmit_data_irrc(node, h, &node->msg.rx_xmit_data_irrc);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_XMIT_DATA_ISC:
-        arachnae_xmit_data_isc_unpack(payload, h->length, &node->msg.rx_xmit_data_isc);
+    }
+    case ARACHNAE_OP_XMIT_DATA_ISC: {
+        /* arachnae_xmit_data_isc_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_xmit_data_isc.longitudinal = (int8_t)arachnae_sext((uint16_t)((unsigned)payload[0]), 0x80u, 0xFFu);
+        node->msg.rx_xmit_data_isc.transverse = (int8_t)arachnae_sext((uint16_t)((unsigned)payload[1]), 0x80u, 0xFFu);
         spu_on_xmit_data_isc(node, h, &node->msg.rx_xmit_data_isc);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_XMIT_DATA_TSC:
-        arachnae_xmit_data_tsc_unpack(payload, h->length, &node->msg.rx_xmit_data_tsc);
+    }
+    case ARACHNAE_OP_XMIT_DATA_TSC: {
+        /* arachnae_xmit_data_tsc_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_xmit_data_tsc.channel = (uint8_t)((unsigned)payload[0]);
+        node->msg.rx_xmit_data_tsc.temperature = (int8_t)arachnae_sext((uint16_t)((unsigned)payload[1]), 0x80u, 0xFFu);
         spu_on_xmit_data_tsc(node, h, &node->msg.rx_xmit_data_tsc);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_XMIT_DATA_LSC:
-        arachnae_xmit_data_lsc_unpack(payload, h->length, &node->msg.rx_xmit_data_lsc);
+    }
+    case ARACHNAE_OP_XMIT_DATA_LSC: {
+        /* arachnae_xmit_data_lsc_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_xmit_data_lsc.brightness = (uint8_t)((unsigned)payload[0]);
         spu_on_xmit_data_lsc(node, h, &node->msg.rx_xmit_data_lsc);
         return ARACHNAE_OK;
-    case ARACHNAE_OP_XMIT_DATA_PSC:
-        arachnae_xmit_data_psc_unpack(payload, h->length, &node->msg.rx_xmit_data_psc);
+    }
+    case ARACHNAE_OP_XMIT_DATA_PSC: {
+        /* arachnae_xmit_data_psc_unpack, inlined: one call less per message (issue 15) */
+        node->msg.rx_xmit_data_psc.voltage = (uint8_t)((unsigned)payload[0]);
         spu_on_xmit_data_psc(node, h, &node->msg.rx_xmit_data_psc);
         return ARACHNAE_OK;
-    default:
-        return ARACHNAE_OK;
+    }
+    default:   /* not reached: the payload check refused every other opcode */
+        return ARACHNAE_OPCODE;
     }
     /* node->out holds the largest reply of this role (node_spu.h), so it fits */
-    (void)arachnae_frame_seal(op, h->src, node->address, node->out, n, &node->out_len);
+    node->out[ARACHNAE_FRAME_OPCODE] = op;
+    node->out[ARACHNAE_FRAME_LENGTH] = n;
+    (void)arachnae_frame_seal(node->out, h->src, node->address, &node->out_len);
     spu_send(node, node->out, node->out_len);
     return ARACHNAE_OK;
-}
-
-arachnae_status spu_dispatch(spu_node *node, const uint8_t *frame, uint16_t len)
-{
-    arachnae_status st = arachnae_frame_check(frame, len, node->address);
-    if (st != ARACHNAE_OK)
-        return st;
-    arachnae_frame_header(frame, &node->rx);
-    st = spu_payload_check(node->rx.opcode, frame + ARACHNAE_FRAME_PAYLOAD, node->rx.length);
-    if (st == ARACHNAE_OK)
-        st = deliver(node, &node->rx, frame + ARACHNAE_FRAME_PAYLOAD);
-    return arachnae_unhandled_note(&node->unhandled, node->rx.opcode, st);
 }

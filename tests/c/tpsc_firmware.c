@@ -37,7 +37,7 @@ int main(void)
             uint16_t len = 0;
             const uint8_t *frame = arachnae_parser_frame(&parser, &len);
             if (frame != NULL)
-                (void)tpsc_dispatch(&node, frame, len);
+                (void)tpsc_dispatch(&node, frame);
         }
     }
     (void)arachnae_parser_gap(&parser);

@@ -11,14 +11,13 @@ import pytest
 from tests.firmware.conftest import FIRMWARE, make
 
 SENSORS = ("usrc", "tpsc", "irrc", "isc", "tsc", "lsc", "psc")
-# Issue 15's targets where they are met (fifth session): every role in 2 KiB, the TPSC in 1 KiB. The other
-# sensor roles (with their C behaviours, which link their XMIT_DATA builders) are guarded at today's figure plus
-# a little room (USRC 1318 B is the largest); the TPSC's 1.5x of its baseline (612 B) is not met, nor since the
-# frame check's ROUTE verdict (issue 10: source and broadcast checked in the generated parser, +26 B) its 1 KiB. `make size`
-# prints each role against its budget; the report carries the gap.
-ROLE_CEILING = 2048     # issue 15 / 6: any role's codec + skeleton in 2 KiB (met: the SPU is 2000 B)
-TPSC_CEILING = 1050     # issue 15 asks 1 KiB for a sensor role: TPSC 1020 B before the ROUTE check, 1046 B with it
-SENSOR_CEILING = 1330   # not the issue's 1024: today's largest sensor role (USRC 1318 B) plus room
+# Issue 15's targets where they are met (sixth session): every role in 2 KiB and every sensor role in 1 KiB of AVR
+# flash (codec + skeleton; USRC 986 B is the largest sensor role, the SPU 1480 B the largest role). The TPSC's 1.5x
+# of its hand-written baseline (612 B) is not met: it is guarded at today's figure (766 B) plus a little room, and
+# `make size` prints the ratio; the report carries the gap.
+ROLE_CEILING = 2048     # issue 15 / 6: any role's codec + skeleton in 2 KiB
+SENSOR_CEILING = 1024   # issue 15: a sensor role's codec + skeleton in 1 KiB
+TPSC_CEILING = 780      # not the issue's 1.5 x baseline (612 B): TPSC 766 B today
 
 
 # roles with a hand-written baseline (firmware/baseline/, BASELINE_ROLES in firmware/Makefile): RLC is a first-level node
@@ -52,7 +51,7 @@ def test_size_report_runs_and_the_codec_has_no_data_or_bss(firmware_built, spec)
             assert row["codec"]["text"] > 0 and row["skeleton"]["text"] > 0, row
 
 
-def test_codec_and_skeleton_stay_under_todays_ceilings(firmware_built):
+def test_codec_and_skeleton_meet_the_issue_15_budgets(firmware_built):
     used = avr_codec_skeleton(report(firmware_built)[1])
     assert used["tpsc"] <= TPSC_CEILING, used
     assert all(used[r] <= SENSOR_CEILING for r in SENSORS), used

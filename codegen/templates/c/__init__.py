@@ -491,8 +491,10 @@ def view(spec: Spec) -> dict:
                     raise N.Unsupported(N.of_role(spec, role), f"receives {ID_REQ} but does not send {ID_ACK} (seed 3.2.2)")
                 rv.id_ack = by_name[ID_ACK]
                 node_fields = [fv.name for fv in rv.id_ack.fields if fv.kind == "node" and not fv.is_array]
-                if len(rv.id_ack.fields) != 1 or not node_fields:
-                    raise N.Unsupported(rv.id_ack.origin, "must carry exactly one field, the node address (seed 3.2.2)")
+                # the skeleton writes the own address as the payload's one byte (node.c.j2, issue 15)
+                if len(rv.id_ack.fields) != 1 or not node_fields or rv.id_ack.fields[0].bits != 8 \
+                        or rv.id_ack.fields[0].byte != 0 or rv.id_ack.max_size != 1:
+                    raise N.Unsupported(rv.id_ack.origin, "must carry exactly one field, the node address in one byte (seed 3.2.2)")
                 rv.id_ack_field = node_fields[0]
             elif mv.name == STATUS_REQ:
                 rv.status_req = mv
