@@ -452,6 +452,19 @@ class Spec:
         return sorted((m for m in self.messages if m.record and role in m.senders and master_role in m.receivers),
                       key=lambda m: -m.max_size)
 
+    def fetched_records(self, bus: str) -> dict[str, list[Message]]:
+        """seed 3.2.2: per slave role of `bus` (address order), the records it answers the bus's fetch_message with,
+        longest first; empty for a bus without one (polled)."""
+        b = self.buses[bus]
+        if b.fetch_message is None:
+            return {}
+        master = self.node(b.master).role
+        out: dict[str, list[Message]] = {}
+        for n in self.slaves(bus):
+            if n.role not in out and self.records(n.role, master):
+                out[n.role] = self.records(n.role, master)
+        return out
+
     def requirement(self, name: str) -> Requirement | None:
         return self.requirements.get(name)
 

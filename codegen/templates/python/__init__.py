@@ -223,8 +223,15 @@ def outputs(spec: Spec) -> list[Output]:
     for n in spec.nodes:
         routes[n.address] = {o.address: spec.shared_bus(n, o).name for o in spec.nodes  # type: ignore[union-attr]
                              if o is not n and spec.shared_bus(n, o) is not None}
+    # seed 3.2.2: per fetch message, the records each slave role answers it with (spec `record: true`)
+    fetched: dict[str, dict[str, list[str]]] = {}
+    for bus in spec.buses.values():
+        if bus.fetch_message is not None:
+            by_role = fetched.setdefault(camel(bus.fetch_message), {})
+            for role, records in spec.fetched_records(bus.name).items():
+                by_role.setdefault(role, [camel(m.name) for m in records])
     width = spec.frame.checksum.width
-    ctx = {"errors": ERROR_KINDS, "msgs": msgs, "roles": roles, "tables": log_tables(spec), "crc_fast": crc_fast(spec), "routes": routes,
+    ctx = {"errors": ERROR_KINDS, "msgs": msgs, "fetched": fetched, "roles": roles, "tables": log_tables(spec), "crc_fast": crc_fast(spec), "routes": routes,
            "crc_shift": width - 8, "crc_top": 1 << (width - 1), "crc_mask": (1 << width) - 1}
     out = [
         Output("__init__.py", "init.py.j2", ctx),

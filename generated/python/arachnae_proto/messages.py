@@ -2442,3 +2442,24 @@ for _m in MESSAGES:
     _m._ARRAY_INFO = next((f for f in _m.FIELDS if f.count is not None), None)
 BY_OPCODE = {m.OPCODE: m for m in MESSAGES}
 BY_NAME = {m.NAME: m for m in MESSAGES}
+
+# seed 3.2.2: what a master's fetch (nodes.yaml buses.<bus>.fetch_message) is answered with, per slave role:
+# the records (messages.<m>.record) that role sends the master of its bus, longest first.
+FETCHED_RECORDS = {
+    XmitGrant: {
+        "NP3": (Move, ),
+        "SPU": (XmitRecord, ),
+        "APU_SDF": (XmitRecord, ),
+        "UIC_RCP": (Move, PostReq, ),
+        "RLC": (XmitRecord, ),
+    },
+    XmitData: {
+        "USRC": (XmitDataUsrc, ),
+        "TPSC": (XmitDataTpsc, ),
+        "IRRC": (XmitDataIrrc, ),
+        "ISC": (XmitDataIsc, ),
+        "TSC": (XmitDataTsc, ),
+        "LSC": (XmitDataLsc, ),
+        "PSC": (XmitDataPsc, ),
+    },
+}
