@@ -7,7 +7,8 @@ Use (the uart decoder at the bus's baud rate, 8N1; SIGROKDECODE_DIR naming gener
         -P uart:baudrate=2400:rx=sensor,arachnae:bus=sensor -A arachnae
 A frame ends when the line stays idle for the bus's idle gap (less one bit of
 sampling tolerance); the length byte then tells where the CRC is and whether
-bytes are missing (TRUNCATED) or extra (OVERSIZE), checked in the codecs' order.
+bytes are missing (TRUNCATED) or extra (OVERSIZE), checked in the codecs' order
+(then CHECKSUM, ROUTE as a codec without an own address, OPCODE, LENGTH, RANGE).
 """
 
 from collections import namedtuple
@@ -74,6 +75,9 @@ NODES = {
     44: 'LSC',
     45: 'PSC',
 }
+
+# seed 3.2.1: the opcodes a master may send to broadcast (spec messages.yaml `broadcast: true`)
+MAY_BROADCAST = frozenset((1, ))
 
 ENUMS = {
     'MOV_CMD': {0: 'STOP', 1: 'FORWARD', 2: 'BACKWARD', 3: 'TURN_RIGHT', 4: 'TURN_LEFT', 5: 'SIDESTEP_RIGHT', 6: 'SIDESTEP_LEFT', 7: 'TRIPOD', 8: 'RIPPLE', 9: 'WAVE'},
@@ -290,7 +294,7 @@ MESSAGES = {
 
 
 class CheckFailed(Exception):
-    """One of the codecs' checks failed: kind (TRUNCATED, OVERSIZE, CHECKSUM, OPCODE, LENGTH, RANGE) and why."""
+    """One of the codecs' checks failed: kind (TRUNCATED, OVERSIZE, CHECKSUM, ROUTE, OPCODE, LENGTH, RANGE) and why."""
 
     def __init__(self, kind, text):
         super().__init__(text)
@@ -362,6 +366,19 @@ def field_value(f, payload):
     return raw
 
 
+def check_route(dst, src, opcode):
+    """ROUTE (seed 3.2.1), as the codecs' frame check without an own address (a decoder on the line is no node):
+    not from a node, to no node, or to broadcast with a message the spec does not mark broadcast."""
+    if dst == BROADCAST:
+        if opcode not in MAY_BROADCAST:
+            what = MESSAGES[opcode].name if opcode in MESSAGES else "opcode 0x%02X" % opcode
+            raise CheckFailed("ROUTE", "%s to broadcast 0x%02X, but the spec does not mark %s broadcast" % (what, BROADCAST, what))
+    elif dst not in NODES:
+        raise CheckFailed("ROUTE", "destination 0x%02X is not a node address" % dst)
+    if src not in NODES:
+        raise CheckFailed("ROUTE", "source 0x%02X is not a node address" % src)
+
+
 def decode(data):
     """(message, {field: raw}) of a whole frame, or CheckFailed in the codecs' order of checks."""
     n = len(data)
@@ -375,6 +392,7 @@ def decode(data):
     got, want = int.from_bytes(bytes(data[-CRC_SIZE:]), "big"), crc(data[:-CRC_SIZE])
     if got != want:
         raise CheckFailed("CHECKSUM", "checksum 0x%04X does not match, expected 0x%04X" % (got, want))
+    check_route(data[0], data[1], data[2])
     m = MESSAGES.get(data[2])
     if m is None:
         raise CheckFailed("OPCODE", "unknown opcode 0x%02X" % data[2])
