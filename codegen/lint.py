@@ -257,6 +257,25 @@ def _lint_reflexes(path: Path, doc: dict, messages_doc: dict, report: Report) ->
 
 
 # -- messages -------------------------------------------------------------------
+def _lint_reply(path: Path, doc: dict, i: int, m: dict, report: Report) -> None:
+    """seed 3.2.2: a reply goes back from a receiver of its request to a sender of it, and a role answers a
+    request with one message only (which one the skeletons send)."""
+    at = ["messages", i, "reply_to"]
+    request = next((r for r in doc["messages"] if r["name"] == m["reply_to"]), None)
+    if request is None:
+        report.add(path, doc, at, f"{m['name']}: reply_to unknown message '{m['reply_to']}'")
+        return
+    for side, other, says in (("from", "to", "receive"), ("to", "from", "send")):
+        stray = [r for r in m[side] if r not in request[other]]
+        if stray:
+            report.add(path, doc, at, f"{m['name']}: {', '.join(stray)} do(es) not {says} {request['name']}, "
+                                      f"so cannot be on the `{side}` side of its reply")
+    for other in doc["messages"][:i]:
+        both = [r for r in m["from"] if other.get("reply_to") == m["reply_to"] and r in other["from"]]
+        if both:
+            report.add(path, doc, at, f"{m['name']}: {', '.join(both)} already answer(s) {m['reply_to']} with {other['name']}")
+
+
 def _lint_messages(path: Path, doc: dict, nodes_doc: dict, roles: set[str], report: Report, check_routes: bool) -> None:
     _lint_checksum(path, doc, report)
     _lint_enum_subsets(path, doc, report)
@@ -279,6 +298,8 @@ def _lint_messages(path: Path, doc: dict, nodes_doc: dict, roles: set[str], repo
             report.add(path, doc, ["messages", i, "relayed_as"], f"{m['name']}: relayed_as unknown message '{m['relayed_as']}'")
         elif "relayed_as" in m and not m.get("record"):
             report.add(path, doc, ["messages", i, "relayed_as"], f"{m['name']}: relayed_as is for records (`record: true`)")
+        if "reply_to" in m:
+            _lint_reply(path, doc, i, m, report)
         if m.get("record") and (len(m["to"]) != 1 or m.get("broadcast")):
             report.add(path, doc, ["messages", i, "record"], f"{m['name']}: a record goes to one master role, not {'/'.join(m['to'])}"
                        f"{' or a broadcast' if m.get('broadcast') else ''}")

@@ -273,6 +273,7 @@ class Message:
     fields: tuple[Field, ...]
     relayed_as: str | None = None   # the MCP delivers this record to its target as that message
     record: bool = False            # a slave's record: what it hands its master when fetched (seed 3.2.2)
+    reply_to: str | None = None     # the request this message answers (seed 3.2.2: a reply within the response timeout)
 
     @property
     def fixed_size(self) -> int:
@@ -465,6 +466,10 @@ class Spec:
                 out[n.role] = self.records(n.role, master)
         return out
 
+    def reply(self, request: str, role: str) -> Message | None:
+        """The message `role` answers `request` with (spec messages.<m>.reply_to; the lint allows one per role)."""
+        return next((m for m in self.messages if m.reply_to == request and role in m.senders), None)
+
     def requirement(self, name: str) -> Requirement | None:
         return self.requirements.get(name)
 
@@ -585,7 +590,7 @@ def build(nodes_doc: dict, messages_doc: dict, sources: tuple[Path, ...], digest
                 origin=m.get("origin", "seed"), broadcast=bool(m.get("broadcast", False)),
                 senders=tuple(m["from"]), receivers=tuple(m["to"]), doc=m["doc"],
                 fields=_fields(m.get("fields", []), enums, flags, fdoc["max_payload"]), relayed_as=m.get("relayed_as"),
-                record=bool(m.get("record", False)))
+                record=bool(m.get("record", False)), reply_to=m.get("reply_to"))
         for m in messages_doc["messages"]
     )
     p = nodes_doc["protocol"]

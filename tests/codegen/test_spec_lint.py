@@ -84,6 +84,15 @@ CASES = [
      "    subset_of: MOV_CMD\n    values: {TRIPOD: 7}\n    names: [TRIPOD, RIPPLE, WAVE]", "  GAIT:\n",
      "GAIT: needs either `values` or `subset_of` with `names`"),
     ("line_unknown_node", N, 'node: "UIC/RCP"', 'node: "UIC/RCX"', None, "line rcp: unknown node 'UIC/RCX'"),
+    ("reply_to_unknown", M, "    reply_to: POST_QUERY\n", "    reply_to: POST_QUERRY\n", None,
+     "POST_REPORT: reply_to unknown message 'POST_QUERRY'"),
+    ("reply_from_a_non_receiver", M, "    reply_to: ID_REQ\n", "    reply_to: POST_QUERY\n", None,
+     "ID_ACK: NP3, SSC, APU_SDF, UIC_RCP, RLC, USRC, TPSC, IRRC, ISC, TSC, LSC, PSC, JAC do(es) not receive POST_QUERY, "
+     "so cannot be on the `from` side of its reply"),
+    ("two_replies_of_a_role", M, "    from: [NP3, SPU, SSC, APU_SDF, UIC_RCP, RLC]\n    to: [MCP]",
+     "    from: [NP3, SPU, SSC, APU_SDF, UIC_RCP, RLC, MMC]\n    to: [MCP]",
+     "name: STATUS_ACK_MMC\n    seed_name: STATUS_ACK\n    reply_to: STATUS_REQ",
+     "STATUS_ACK_MMC: MMC already answer(s) STATUS_REQ with STATUS_ACK_BUSY"),
 ]
 
 
