@@ -24,7 +24,7 @@ class Verdict:
 
 
 def behind(address: int) -> list[int]:
-    """Every node reached only through `address` (decision 2): its bus's slaves, recursively."""
+    """Every node reached only through `address` (docs/decisions.md D2): its bus's slaves, recursively."""
     bus = NODES[address].masters
     out: list[int] = []
     if bus is not None:

@@ -458,7 +458,7 @@ def _num(v: Fraction) -> str:
 
 
 def _lint_routes(path: Path, doc: dict, at: list, m: dict, nodes_doc: dict, report: Report) -> None:
-    """Every sender must reach some receiver over one bus, and every receiver some sender (decision 2)."""
+    """Every sender must reach some receiver over one bus, and every receiver some sender (docs/decisions.md D2)."""
     nodes = nodes_doc["nodes"]
 
     def share(a: dict, b: dict) -> bool:
@@ -471,7 +471,7 @@ def _lint_routes(path: Path, doc: dict, at: list, m: dict, nodes_doc: dict, repo
             members = [n for n in group if n["role"] == role]
             if not any(share(n, o) for n in members for o in other if o is not n):
                 peers = "/".join(m["to"] if side == "from" else m["from"])
-                report.add(path, doc, at + [side], f"{m['name']}: {role} and {peers} are not on one bus (decision 2: masters relay between layers)")
+                report.add(path, doc, at + [side], f"{m['name']}: {role} and {peers} are not on one bus (docs/decisions.md D2: masters relay between layers)")
     if m.get("broadcast"):
         for role in m["from"]:
             if not any(n.get("masters") for n in nodes if n["role"] == role):

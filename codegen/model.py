@@ -484,7 +484,7 @@ class Spec:
         return None
 
     def routes(self, message: Message) -> Iterator[tuple[Node, Node, Bus]]:
-        """Every (sender, receiver, bus) the message may travel between (decision 2)."""
+        """Every (sender, receiver, bus) the message may travel between (docs/decisions.md D2)."""
         for s in self.nodes:
             if s.role not in message.senders:
                 continue

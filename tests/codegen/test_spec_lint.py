@@ -53,7 +53,7 @@ CASES = [
      "{name: error, type: enum, enum: MMC_ERROR, bits: 4}", "STATUS_ACK_MMC.error: enum MMC_ERROR has value 16, wider than 4 bits"),
     ("unknown_role", M, "from: [NP3, UIC_RCP]", "from: [NP3, UIC_RPC]", None, "MOVE: unknown node role 'UIC_RPC' in `from`"),
     ("not_on_one_bus", M, "    from: [USRC]\n    to: [SPU]", "    from: [USRC]\n    to: [MCP]", None,
-     "XMIT_DATA_USRC: MCP and USRC are not on one bus (decision 2: masters relay between layers)"),
+     "XMIT_DATA_USRC: MCP and USRC are not on one bus (docs/decisions.md D2: masters relay between layers)"),
     ("unknown_count_field", M, "{name: missing, type: node, count: missing_count}", "{name: missing, type: node, count: missing_cnt}", None,
      "POST_REPORT.missing: count refers to 'missing_cnt', which is not an earlier field"),
     ("checksum_check_value", M, "check: 0x29B1", "check: 0x29B2", None,
