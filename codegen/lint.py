@@ -257,6 +257,23 @@ def _lint_reflexes(path: Path, doc: dict, messages_doc: dict, report: Report) ->
 
 
 # -- messages -------------------------------------------------------------------
+def _lint_carried(path: Path, doc: dict, i: int, m: dict, report: Report) -> None:
+    """A message `carried_in` another travels as a code of one of its fields: the carrier goes between the same
+    roles and has a flags bit or enum value of the message's name (seed 3.2.12: OBJ_LEFT in XMIT_DATA_TPSC)."""
+    at = ["messages", i, "carried_in"]
+    carrier = next((c for c in doc["messages"] if c["name"] == m["carried_in"]), None)
+    if carrier is None or carrier is m:
+        report.add(path, doc, at, f"{m['name']}: carried_in unknown message '{m['carried_in']}'")
+        return
+    if (set(carrier["from"]), set(carrier["to"])) != (set(m["from"]), set(m["to"])):
+        report.add(path, doc, at, f"{m['name']}: carried_in {carrier['name']}, which goes between other roles")
+    codes = [f.get("flags") or f.get("enum") for f in carrier.get("fields", [])]
+    named = [c for c in codes if c and m["name"] in ((doc.get("flags", {}).get(c) or {}).get("bits", {})
+                                                     or (doc.get("enums", {}).get(c) or {}).get("values", {}))]
+    if not named:
+        report.add(path, doc, at, f"{m['name']}: {carrier['name']} has no flags bit or enum value named {m['name']} to carry it")
+
+
 def _lint_reply(path: Path, doc: dict, i: int, m: dict, report: Report) -> None:
     """seed 3.2.2: a reply goes back from a receiver of its request to a sender of it, and a role answers a
     request with one message only (which one the skeletons send)."""
@@ -300,6 +317,8 @@ def _lint_messages(path: Path, doc: dict, nodes_doc: dict, roles: set[str], repo
             report.add(path, doc, ["messages", i, "relayed_as"], f"{m['name']}: relayed_as is for records (`record: true`)")
         if "reply_to" in m:
             _lint_reply(path, doc, i, m, report)
+        if "carried_in" in m:
+            _lint_carried(path, doc, i, m, report)
         if m.get("record") and (len(m["to"]) != 1 or m.get("broadcast")):
             report.add(path, doc, ["messages", i, "record"], f"{m['name']}: a record goes to one master role, not {'/'.join(m['to'])}"
                        f"{' or a broadcast' if m.get('broadcast') else ''}")

@@ -274,6 +274,7 @@ class Message:
     relayed_as: str | None = None   # the MCP delivers this record to its target as that message
     record: bool = False            # a slave's record: what it hands its master when fetched (seed 3.2.2)
     reply_to: str | None = None     # the request this message answers (seed 3.2.2: a reply within the response timeout)
+    carried_in: str | None = None   # sent as a code inside that message's field, never as a frame of its own
 
     @property
     def fixed_size(self) -> int:
@@ -590,7 +591,8 @@ def build(nodes_doc: dict, messages_doc: dict, sources: tuple[Path, ...], digest
                 origin=m.get("origin", "seed"), broadcast=bool(m.get("broadcast", False)),
                 senders=tuple(m["from"]), receivers=tuple(m["to"]), doc=m["doc"],
                 fields=_fields(m.get("fields", []), enums, flags, fdoc["max_payload"]), relayed_as=m.get("relayed_as"),
-                record=bool(m.get("record", False)), reply_to=m.get("reply_to"))
+                record=bool(m.get("record", False)), reply_to=m.get("reply_to"),
+                carried_in=m.get("carried_in"))
         for m in messages_doc["messages"]
     )
     p = nodes_doc["protocol"]

@@ -93,6 +93,12 @@ CASES = [
      "    from: [NP3, SPU, SSC, APU_SDF, UIC_RCP, RLC, MMC]\n    to: [MCP]",
      "name: STATUS_ACK_MMC\n    seed_name: STATUS_ACK\n    reply_to: STATUS_REQ",
      "STATUS_ACK_MMC: MMC already answer(s) STATUS_REQ with STATUS_ACK_BUSY"),
+    ("carried_in_unknown", M, "{name: OBJ_BOTH, opcode: 0x50, section: \"3.2.12\", carried_in: XMIT_DATA_TPSC,",
+     "{name: OBJ_BOTH, opcode: 0x50, section: \"3.2.12\", carried_in: XMIT_DATA_TPSX,", None,
+     "OBJ_BOTH: carried_in unknown message 'XMIT_DATA_TPSX'"),
+    ("carried_in_without_its_code", M, "bits: {OBJ_LEFT: 0x10, OBJ_RIGHT: 0x20, OBJ_BOTH: 0x40}",
+     "bits: {OBJ_LEFT: 0x10, OBJ_RIGHT: 0x20, BOTH: 0x40}", "carried_in: XMIT_DATA_TPSC, from: [TPSC], to: [SPU], doc: \"Both",
+     "OBJ_BOTH: XMIT_DATA_TPSC has no flags bit or enum value named OBJ_BOTH to carry it"),
 ]
 
 
