@@ -9,15 +9,14 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
-import math
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
 import jsonschema
-import yaml
 
 from arachnae.errors import UserError, located
+from arachnae.validation import Validator
 from codegen.encoding import Linear, Log10, to_fraction
 from codegen.generate import LANGUAGES
 from codegen.model import Checksum, Spec, enum_values_of
@@ -40,23 +39,6 @@ class Report:
             raise UserError("\n".join(self.problems))
 
 
-def _is_integer(_checker: Any, value: Any) -> bool:
-    """An int, never a bool (YAML's true is an int in Python) and never a float such as 2.0."""
-    return isinstance(value, int) and not isinstance(value, bool)
-
-
-def _is_number(_checker: Any, value: Any) -> bool:
-    """A finite int or float: NaN and infinity are not numbers a spec can mean."""
-    return _is_integer(_checker, value) or isinstance(value, float) and math.isfinite(value)
-
-
-# JSON Schema's own types accept 2.0 as an integer and NaN as a number; the spec does not.
-_Validator = jsonschema.validators.extend(
-    jsonschema.Draft202012Validator,
-    type_checker=jsonschema.Draft202012Validator.TYPE_CHECKER.redefine_many({"integer": _is_integer, "number": _is_number}),
-)
-
-
 def one_line(text: str) -> str:
     """A diagnostic stays one line whatever the spec's strings contain."""
     return "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in text)
@@ -73,8 +55,7 @@ def _lint_text(path: Path, doc: Any, node: Any, where: list[Any], report: Report
 
 
 def _schema_check(path: Path, doc: Any, schema_name: str, report: Report) -> None:
-    schema = yaml.safe_load((SCHEMA_DIR / schema_name).read_text())
-    validator = _Validator(schema)
+    validator = Validator(load_yaml(SCHEMA_DIR / schema_name))
     by_field: dict[tuple[str, ...], list[jsonschema.ValidationError]] = {}
     for err in sorted(validator.iter_errors(doc), key=lambda e: list(map(str, e.absolute_path))):
         by_field.setdefault(tuple(map(str, err.absolute_path)), []).append(err)
