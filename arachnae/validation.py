@@ -1,13 +1,16 @@
 """JSON Schema over the line-tracking documents of arachnae.yamlio, with one-line `file:line: field: problem` errors.
 
 Why: structure is declared once as a schema (the spec in codegen/schema/, scenarios in
-sim2d/scenario.schema.yaml) instead of being hand-coded, and every violation still names
-the file and line it came from. A schema may give a friendlier text per keyword with
-`x-messages: {keyword: text}`.
+sim2d/scenario.schema.yaml, sweeps in sim2d/sweep.schema.yaml) instead of being hand-coded,
+and every violation still names the file and line it came from. `Validator` is the one
+JSON Schema validator of the toolkit (the spec's lint uses it too). A schema may give a
+friendlier text per keyword with `x-messages: {keyword: text}`.
 """
 from __future__ import annotations
 
 from typing import Any, Iterator, Sequence
+
+import math
 
 import jsonschema
 from jsonschema import validators
@@ -15,10 +18,19 @@ from jsonschema import validators
 from arachnae.errors import UserError
 from arachnae.yamlio import LDict, LList, locate, where
 
-# 2.0 is not an integer here: a float where a count or seed is meant is a mistake (issue 10, item 3)
-_TYPES = jsonschema.Draft202012Validator.TYPE_CHECKER.redefine(
-    "integer", lambda _checker, v: isinstance(v, int) and not isinstance(v, bool))
-Validator = validators.extend(jsonschema.Draft202012Validator, type_checker=_TYPES)
+def _is_integer(_checker: Any, value: Any) -> bool:
+    """An int, never a bool (YAML's true is an int in Python) and never a float such as 2.0: a float where a
+    count, address or seed is meant is a mistake (issue 10, item 3)."""
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _is_number(_checker: Any, value: Any) -> bool:
+    """A finite int or float: NaN and infinity are no value a spec or scenario can mean."""
+    return _is_integer(_checker, value) or isinstance(value, float) and math.isfinite(value)
+
+
+Validator = validators.extend(jsonschema.Draft202012Validator, type_checker=jsonschema.Draft202012Validator.TYPE_CHECKER
+                              .redefine_many({"integer": _is_integer, "number": _is_number}))
 
 _TYPE_WORDS = {"number": "a number", "integer": "an integer", "array": "a list", "object": "a mapping",
                "boolean": "true or false", "string": "text", "null": "nothing"}

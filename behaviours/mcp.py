@@ -42,7 +42,7 @@ def lcd_lines(*lines: str) -> tuple[str, ...]:
 
 
 def top_missing(names: tuple[str, ...]) -> tuple[str, ...]:
-    """The missing nodes not merely behind another missing one (decision 2): the MMC, not its 24 legs' nodes."""
+    """The missing nodes not merely behind another missing one (docs/decisions.md D2): the MMC, not its 24 legs' nodes."""
     gone = {ADDRESS_OF[n] for n in names}
     hidden = {b for a in gone for b in behind(a)}
     return tuple(n for n in names if ADDRESS_OF[n] not in hidden)

@@ -24,7 +24,7 @@ class Verdict:
 
 
 def behind(address: int) -> list[int]:
-    """Every node reached only through `address` (decision 2): its bus's slaves, recursively."""
+    """Every node reached only through `address` (docs/decisions.md D2): its bus's slaves, recursively."""
     bus = NODES[address].masters
     out: list[int] = []
     if bus is not None:
@@ -82,9 +82,11 @@ class PostMaster:
         missing: list[int] = []
         retries = self.links[self.master_bus].timing.id_retries          # type: ignore[attr-defined]
         inactive = set()
-        for cls in (M.StatusAckOrder, M.StatusAckRange):
-            enum = cls.FIELDS[0].enum
-            inactive |= {(cls, int(enum[s])) for s in POST.inactive_statuses if s in enum.__members__}  # type: ignore[attr-defined]
+        # seed 6.3: a status reply (spec reply_to STATUS_REQ) whose status names one of the POST's inactive statuses
+        for cls in (m for m in M.MESSAGES if m.REPLY_TO == M.StatusReq.NAME):
+            enum = next((f.enum for f in cls.FIELDS if f.name == "status" and f.enum is not None), None)
+            if enum is not None:
+                inactive |= {(cls, int(enum[s])) for s in POST.inactive_statuses if s in enum.__members__}  # type: ignore[attr-defined]
 
         def lost(a: int) -> None:
             missing.append(a)

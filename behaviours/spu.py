@@ -47,8 +47,8 @@ def channels(role: str, msg: Any) -> dict[int, int]:
         return {int(IscAxis.LONGITUDINAL): msg.longitudinal, int(IscAxis.TRANSVERSE): msg.transverse}
     if role == "TSC":
         return {msg.channel: msg.temperature}
-    field = XMIT_DATA_OF[role].FIELDS[0].name
-    return {0: getattr(msg, field)}
+    (only,) = XMIT_DATA_OF[role].FIELDS           # TPSC, LSC, PSC: a record of one field
+    return {0: getattr(msg, only.name)}
 
 
 def alarm_setup() -> list[tuple[str, M.Message, list[tuple[int, AlarmLimit]]]]:

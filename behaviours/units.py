@@ -16,9 +16,9 @@ from arachnae_proto import messages as _M
 from arachnae_proto.convert import LinearConv, LogConv
 from arachnae_proto.messages import Message
 
-# each sensor role's own XMIT_DATA layout (the spec's XMIT_DATA_<role> messages)
-XMIT_DATA_OF: dict[str, type[Message]] = {
-    m.SENDERS[0]: m for m in _M.MESSAGES if m.SEED_NAME == "XMIT_DATA" and m is not _M.XmitData}
+# seed 3.2.11: each sensor role's own XMIT_DATA layout, the record it answers the SPU's XMIT_DATA with
+# (spec: the sensor bus's fetch_message and the records marked `record: true`)
+XMIT_DATA_OF: dict[str, type[Message]] = {role: records[0] for role, records in _M.FETCHED_RECORDS[_M.XmitData].items()}
 
 
 def record_byte(raw: int) -> int:

@@ -9,15 +9,14 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
-import math
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
 import jsonschema
-import yaml
 
 from arachnae.errors import UserError, located
+from arachnae.validation import Validator
 from codegen.encoding import Linear, Log10, to_fraction
 from codegen.generate import LANGUAGES
 from codegen.model import Checksum, Spec, enum_values_of
@@ -40,23 +39,6 @@ class Report:
             raise UserError("\n".join(self.problems))
 
 
-def _is_integer(_checker: Any, value: Any) -> bool:
-    """An int, never a bool (YAML's true is an int in Python) and never a float such as 2.0."""
-    return isinstance(value, int) and not isinstance(value, bool)
-
-
-def _is_number(_checker: Any, value: Any) -> bool:
-    """A finite int or float: NaN and infinity are not numbers a spec can mean."""
-    return _is_integer(_checker, value) or isinstance(value, float) and math.isfinite(value)
-
-
-# JSON Schema's own types accept 2.0 as an integer and NaN as a number; the spec does not.
-_Validator = jsonschema.validators.extend(
-    jsonschema.Draft202012Validator,
-    type_checker=jsonschema.Draft202012Validator.TYPE_CHECKER.redefine_many({"integer": _is_integer, "number": _is_number}),
-)
-
-
 def one_line(text: str) -> str:
     """A diagnostic stays one line whatever the spec's strings contain."""
     return "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in text)
@@ -73,8 +55,7 @@ def _lint_text(path: Path, doc: Any, node: Any, where: list[Any], report: Report
 
 
 def _schema_check(path: Path, doc: Any, schema_name: str, report: Report) -> None:
-    schema = yaml.safe_load((SCHEMA_DIR / schema_name).read_text())
-    validator = _Validator(schema)
+    validator = Validator(load_yaml(SCHEMA_DIR / schema_name))
     by_field: dict[tuple[str, ...], list[jsonschema.ValidationError]] = {}
     for err in sorted(validator.iter_errors(doc), key=lambda e: list(map(str, e.absolute_path))):
         by_field.setdefault(tuple(map(str, err.absolute_path)), []).append(err)
@@ -257,6 +238,42 @@ def _lint_reflexes(path: Path, doc: dict, messages_doc: dict, report: Report) ->
 
 
 # -- messages -------------------------------------------------------------------
+def _lint_carried(path: Path, doc: dict, i: int, m: dict, report: Report) -> None:
+    """A message `carried_in` another travels as a code of one of its fields: the carrier goes between the same
+    roles and has a flags bit or enum value of the message's name (seed 3.2.12: OBJ_LEFT in XMIT_DATA_TPSC)."""
+    at = ["messages", i, "carried_in"]
+    carrier = next((c for c in doc["messages"] if c["name"] == m["carried_in"]), None)
+    if carrier is None or carrier is m:
+        report.add(path, doc, at, f"{m['name']}: carried_in unknown message '{m['carried_in']}'")
+        return
+    if (set(carrier["from"]), set(carrier["to"])) != (set(m["from"]), set(m["to"])):
+        report.add(path, doc, at, f"{m['name']}: carried_in {carrier['name']}, which goes between other roles")
+    codes = [f.get("flags") or f.get("enum") for f in carrier.get("fields", [])]
+    named = [c for c in codes if c and m["name"] in ((doc.get("flags", {}).get(c) or {}).get("bits", {})
+                                                     or (doc.get("enums", {}).get(c) or {}).get("values", {}))]
+    if not named:
+        report.add(path, doc, at, f"{m['name']}: {carrier['name']} has no flags bit or enum value named {m['name']} to carry it")
+
+
+def _lint_reply(path: Path, doc: dict, i: int, m: dict, report: Report) -> None:
+    """seed 3.2.2: a reply goes back from a receiver of its request to a sender of it, and a role answers a
+    request with one message only (which one the skeletons send)."""
+    at = ["messages", i, "reply_to"]
+    request = next((r for r in doc["messages"] if r["name"] == m["reply_to"]), None)
+    if request is None:
+        report.add(path, doc, at, f"{m['name']}: reply_to unknown message '{m['reply_to']}'")
+        return
+    for side, other, says in (("from", "to", "receive"), ("to", "from", "send")):
+        stray = [r for r in m[side] if r not in request[other]]
+        if stray:
+            report.add(path, doc, at, f"{m['name']}: {', '.join(stray)} do(es) not {says} {request['name']}, "
+                                      f"so cannot be on the `{side}` side of its reply")
+    for other in doc["messages"][:i]:
+        both = [r for r in m["from"] if other.get("reply_to") == m["reply_to"] and r in other["from"]]
+        if both:
+            report.add(path, doc, at, f"{m['name']}: {', '.join(both)} already answer(s) {m['reply_to']} with {other['name']}")
+
+
 def _lint_messages(path: Path, doc: dict, nodes_doc: dict, roles: set[str], report: Report, check_routes: bool) -> None:
     _lint_checksum(path, doc, report)
     _lint_enum_subsets(path, doc, report)
@@ -279,6 +296,10 @@ def _lint_messages(path: Path, doc: dict, nodes_doc: dict, roles: set[str], repo
             report.add(path, doc, ["messages", i, "relayed_as"], f"{m['name']}: relayed_as unknown message '{m['relayed_as']}'")
         elif "relayed_as" in m and not m.get("record"):
             report.add(path, doc, ["messages", i, "relayed_as"], f"{m['name']}: relayed_as is for records (`record: true`)")
+        if "reply_to" in m:
+            _lint_reply(path, doc, i, m, report)
+        if "carried_in" in m:
+            _lint_carried(path, doc, i, m, report)
         if m.get("record") and (len(m["to"]) != 1 or m.get("broadcast")):
             report.add(path, doc, ["messages", i, "record"], f"{m['name']}: a record goes to one master role, not {'/'.join(m['to'])}"
                        f"{' or a broadcast' if m.get('broadcast') else ''}")
@@ -437,7 +458,7 @@ def _num(v: Fraction) -> str:
 
 
 def _lint_routes(path: Path, doc: dict, at: list, m: dict, nodes_doc: dict, report: Report) -> None:
-    """Every sender must reach some receiver over one bus, and every receiver some sender (decision 2)."""
+    """Every sender must reach some receiver over one bus, and every receiver some sender (docs/decisions.md D2)."""
     nodes = nodes_doc["nodes"]
 
     def share(a: dict, b: dict) -> bool:
@@ -450,7 +471,7 @@ def _lint_routes(path: Path, doc: dict, at: list, m: dict, nodes_doc: dict, repo
             members = [n for n in group if n["role"] == role]
             if not any(share(n, o) for n in members for o in other if o is not n):
                 peers = "/".join(m["to"] if side == "from" else m["from"])
-                report.add(path, doc, at + [side], f"{m['name']}: {role} and {peers} are not on one bus (decision 2: masters relay between layers)")
+                report.add(path, doc, at + [side], f"{m['name']}: {role} and {peers} are not on one bus (docs/decisions.md D2: masters relay between layers)")
     if m.get("broadcast"):
         for role in m["from"]:
             if not any(n.get("masters") for n in nodes if n["role"] == role):

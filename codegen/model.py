@@ -273,6 +273,8 @@ class Message:
     fields: tuple[Field, ...]
     relayed_as: str | None = None   # the MCP delivers this record to its target as that message
     record: bool = False            # a slave's record: what it hands its master when fetched (seed 3.2.2)
+    reply_to: str | None = None     # the request this message answers (seed 3.2.2: a reply within the response timeout)
+    carried_in: str | None = None   # sent as a code inside that message's field, never as a frame of its own
 
     @property
     def fixed_size(self) -> int:
@@ -452,6 +454,23 @@ class Spec:
         return sorted((m for m in self.messages if m.record and role in m.senders and master_role in m.receivers),
                       key=lambda m: -m.max_size)
 
+    def fetched_records(self, bus: str) -> dict[str, list[Message]]:
+        """seed 3.2.2: per slave role of `bus` (address order), the records it answers the bus's fetch_message with,
+        longest first; empty for a bus without one (polled)."""
+        b = self.buses[bus]
+        if b.fetch_message is None:
+            return {}
+        master = self.node(b.master).role
+        out: dict[str, list[Message]] = {}
+        for n in self.slaves(bus):
+            if n.role not in out and self.records(n.role, master):
+                out[n.role] = self.records(n.role, master)
+        return out
+
+    def reply(self, request: str, role: str) -> Message | None:
+        """The message `role` answers `request` with (spec messages.<m>.reply_to; the lint allows one per role)."""
+        return next((m for m in self.messages if m.reply_to == request and role in m.senders), None)
+
     def requirement(self, name: str) -> Requirement | None:
         return self.requirements.get(name)
 
@@ -466,7 +485,7 @@ class Spec:
         return None
 
     def routes(self, message: Message) -> Iterator[tuple[Node, Node, Bus]]:
-        """Every (sender, receiver, bus) the message may travel between (decision 2)."""
+        """Every (sender, receiver, bus) the message may travel between (docs/decisions.md D2)."""
         for s in self.nodes:
             if s.role not in message.senders:
                 continue
@@ -572,7 +591,8 @@ def build(nodes_doc: dict, messages_doc: dict, sources: tuple[Path, ...], digest
                 origin=m.get("origin", "seed"), broadcast=bool(m.get("broadcast", False)),
                 senders=tuple(m["from"]), receivers=tuple(m["to"]), doc=m["doc"],
                 fields=_fields(m.get("fields", []), enums, flags, fdoc["max_payload"]), relayed_as=m.get("relayed_as"),
-                record=bool(m.get("record", False)))
+                record=bool(m.get("record", False)), reply_to=m.get("reply_to"),
+                carried_in=m.get("carried_in"))
         for m in messages_doc["messages"]
     )
     p = nodes_doc["protocol"]

@@ -66,8 +66,7 @@ def data_record(spec, role: str):
     """The record a sensor role answers its master's fetch with (seed 3.2.11: XMIT_DATA in each node's encoding;
     spec messages.<m>.record)."""
     bus = spec.role_nodes(role)[0].bus if spec.role_nodes(role) else None
-    master = spec.node(spec.buses[bus].master).role if bus else None
-    records = spec.records(role, master) if master else []
+    records = spec.fetched_records(bus).get(role, []) if bus else []
     if not records:
         raise UserError(f"{spec.sources[-1]}: {role} sends its master no message with `record: true`")
     return records[0]
@@ -106,6 +105,7 @@ class ArbSlave:
     fetch_slots: int          # grant + record
     deliver_slots: int        # relay to the target (0 when the master is the target)
     target: str
+    record: str = "record"    # the message it answers the fetch with (spec `record: true`)
 
 
 @dataclass
@@ -123,6 +123,7 @@ class ArbParams:
     relay: bool = False           # ... which it relays from a bus below (SPU), rather than raises itself (TPSC)
     reflex_gap_slots: int = 0     # whole slots between two reflex records reaching it (reflexes.min_interval_ms)
     reflex_gap_ms: float = 0.0    # ... the spec's interval itself
+    fetch: str | None = None      # what the master fetches a served request's record with (buses.<bus>.fetch_message)
 
 
 def reflex_carrier(spec, bus: str):
@@ -183,8 +184,9 @@ def arbitration(spec, bus: str, scope: str | None = None) -> ArbParams:
     for rank, n in enumerate(nodes):
         fetch, relay, target = record_route(spec, bus, n)
         slaves.append(ArbSlave(n.short, rank, slots(sum(frame_us(spec, bus, f) for f in fetch), slot_us),
-                               slots(sum(frame_us(spec, bus, f) for f in relay), slot_us) if relay else 0, target))
-    p = ArbParams(bus=bus, master=b.master, request=req, slot_us=slot_us, slaves=slaves,
+                               slots(sum(frame_us(spec, bus, f) for f in relay), slot_us) if relay else 0, target,
+                               record=fetch[-1]))
+    p = ArbParams(bus=bus, master=b.master, request=req, slot_us=slot_us, slaves=slaves, fetch=b.fetch_message,
                   backoff_slots=int(rule["backoff_slots"]), max_collisions=int(rule["max_collisions_per_request"]),
                   rule_section=rule.get("section", "3.2.2"), scope=scope or rule["backoff_scope"])
     found = reflex_carrier(spec, bus)

@@ -20,7 +20,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
 
 from arachnae.errors import UserError, located
 from arachnae.validation import Validator, check_schema, field_name, fill_defaults
@@ -34,7 +33,7 @@ from sim2d.robot_params import DEFAULT as DEFAULT_PARAMS
 LIST_KEYS = ("walls", "obstacles", "pits", "slopes", "lights", "heat", "sounds", "faults", "operator")
 MAP_KEYS = ("arena", "robot", "expect", "measure", "speech", "arbitration")
 FAULT_KINDS = ("kill", "mute", "bus", "sensor", "request", "collide")   # scenario.schema.yaml faults
-_SCHEMA: dict[str, Any] = yaml.safe_load((Path(__file__).with_name("scenario.schema.yaml")).read_text())
+_SCHEMA: dict[str, Any] = load_yaml(Path(__file__).with_name("scenario.schema.yaml"))
 
 
 @dataclass(frozen=True)

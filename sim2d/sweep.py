@@ -41,7 +41,7 @@ from sim2d.metrics import lookup, metric_path_problem, metrics_schema
 # the scenario loader's own include merge and schema with the spec's names (one place for both)
 from sim2d.scenario import gather_includes, load_scenario, safe_name, scenario_schema
 
-_SCHEMA: dict[str, Any] = yaml.safe_load(Path(__file__).with_name("sweep.schema.yaml").read_text())
+_SCHEMA: dict[str, Any] = load_yaml(Path(__file__).with_name("sweep.schema.yaml"))
 PARAMS: tuple[str, ...] = tuple(_SCHEMA["properties"]["grid"]["properties"])
 SWEEP_MARKER = ".arachnae-sweep"      # in every results folder: {"sweep", "plan"} as JSON
 MAX_RUNS = 100_000

@@ -127,6 +127,8 @@ class Rules:
         self.move_retries = int(spec.protocol.move_retries)
         self.defer_slots = int(spec.protocol.master_defer_slots)
         self.inactive = set(spec.post.inactive_statuses)
+        # seed 3.2.3: each role's STATUS_ACK form, found by attribute (spec messages.<m>.reply_to), not by name
+        self.status_acks = {m.name for m in spec.messages if m.reply_to == "STATUS_REQ"}
         # seed 3.2.2: the records the MCP relays (spec messages.<m>.record, relayed_as), found by attribute, not name:
         # a record naming its `target` goes there as its relayed_as; the others (MOVE) to that message's receiver
         relays = {m.name: m.relayed_as for m in spec.messages if m.record and m.relayed_as}
@@ -538,7 +540,7 @@ class Validator:
             return False
         last = masters[pos]
         for g in frames[last + 1:]:
-            if self.src(g) == s and g.intact and g.name.startswith("STATUS_ACK"):
+            if self.src(g) == s and g.intact and g.name in self.rules.status_acks:
                 status = getattr(g.parsed.message, "status", None)
                 enum = next((fd.enum for fd in type(g.parsed.message).FIELDS if fd.name == "status"), None)
                 if status is not None and enum is not None and enum(status).name in self.rules.inactive:

@@ -192,7 +192,8 @@ def build(p: ArbParams, variant: str, slaves: int | None = None) -> Model:
     done = (("mph", str(M_IDLE)), ("msrc", "0"), ("mrem", "0"), ("mdst", "0"))
     for i, s in enumerate(sl):
         served = (("err", f"err if ph{i} == {SESSION} else 1"), (f"ph{i}", str(IDLE)))
-        fetch_ev = (Event(m, s.short, "XMIT_GRANT"), Event(s.short, m, "record"))
+        # spec buses.<bus>.fetch_message, answered with the slave's record (messages.<m>.record)
+        fetch_ev = (Event(m, s.short, p.fetch or "fetch"), Event(s.short, m, s.record))
         if s.deliver_slots:
             eff = (("mph", str(M_DELIVER)), ("mrem", str(s.deliver_slots)), ("mdst", str(tcode[s.target])))
         else:

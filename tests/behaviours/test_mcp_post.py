@@ -64,7 +64,7 @@ def test_silent_sub_master_takes_its_bus_with_it(spec):
     rig = post(spec, silent=("SPU",))
     v = rig.node.verdict
     assert v.verdict == "HALTED"
-    assert set(v.missing) == {"SPU", "USRC", "TPSC", "IRRC", "ISC", "TSC", "LSC", "PSC"}   # decision 2
+    assert set(v.missing) == {"SPU", "USRC", "TPSC", "IRRC", "ISC", "TSC", "LSC", "PSC"}   # docs/decisions.md D2
     assert rig.frames(M.PostQuery, A["SPU"]) == []                     # no POST_QUERY to a node that is gone
 
 

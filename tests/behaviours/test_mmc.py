@@ -237,7 +237,7 @@ def test_post_reports_a_missing_leg_and_walks_on_five_in_wave_gait(spec):
     rig.run(3.0)
     (_, f), = rig.frames(M.PostReport)
     jacs_2 = {0x44, 0x45, 0x46}                                   # JAC(2,m) = 0x41 + 3 + (m-1), seed 3.2.18
-    assert set(f.message.missing) == {LCP[2]} | jacs_2            # decision 2: nodes behind it are missing too
+    assert set(f.message.missing) == {LCP[2]} | jacs_2            # docs/decisions.md D2: nodes behind it are missing too
     assert len(rig.frames(M.IdReq, LCP[2])) == 2                  # seed 3.2.2: one retry
     assert rig.node.gait.gait == Gait.WAVE
     assert rig.frames(M.LegTarget, LCP[1]) and not rig.frames(M.LegTarget, LCP[2])

@@ -1,4 +1,4 @@
-"""NP3 node (seed 3.2.3, 5.2, 6, decision 8): DATA records in, MOVE records out, through its subsumption network."""
+"""NP3 node (seed 3.2.3, 5.2, 6, docs/decisions.md D8): DATA records in, MOVE records out, through its subsumption network."""
 from __future__ import annotations
 
 import math

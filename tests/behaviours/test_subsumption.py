@@ -1,4 +1,4 @@
-"""Subsumption library (decision 8, seed 5.2): suppression, inhibition, the control trace, the NP3 network."""
+"""Subsumption library (docs/decisions.md D8, seed 5.2): suppression, inhibition, the control trace, the NP3 network."""
 from __future__ import annotations
 
 import math

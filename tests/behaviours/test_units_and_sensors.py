@@ -6,7 +6,7 @@ from __future__ import annotations
 from arachnae_proto import messages as M
 from arachnae_proto.enums import RangeStatus, TpscContact
 
-from behaviours.units import quantizer
+from behaviours.units import XMIT_DATA_OF, quantizer
 from tests.behaviours.rig import Rig
 
 SPU = 0x04
@@ -26,6 +26,17 @@ def test_seed_encoding_tables_saturate_like_an_adc():
     psc = quantizer(M.XmitDataPsc, "voltage")
     assert psc.raw(3.0) == psc.raw(4.2) < psc.raw(4.6) < psc.raw(5.0) == psc.raw(9)        # seed 3.2.17
     assert psc.phys(psc.raw(4.6)) == 4.6
+
+
+def test_each_sensor_answers_xmit_data_with_its_own_record_from_the_spec(spec):
+    """seed 3.2.11: XMIT_DATA_OF comes from the sensor bus's fetch_message and the records marked in the spec,
+    one per sensor role, each sent by that role to the SPU (not from the messages' seed names)."""
+    sensor = next(b for b in spec.buses.values() if b.fetch_message == M.XmitData.NAME)
+    roles = {n.role for n in spec.slaves(sensor.name)}
+    assert set(XMIT_DATA_OF) == roles
+    for role, cls in XMIT_DATA_OF.items():
+        assert cls.RECORD and cls.SENDERS == (role,) and cls is not M.XmitData
+    assert M.FETCHED_RECORDS[M.XmitGrant]["UIC_RCP"] == (M.Move, M.PostReq)     # longest first
 
 
 def test_tpsc_initiates_with_data_rdy_and_reports_the_whisker(spec):

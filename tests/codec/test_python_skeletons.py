@@ -62,7 +62,7 @@ def test_send_refuses_a_message_the_role_does_not_send_and_cross_layer_routes(sp
     with pytest.raises(ValueError, match="does not send"):
         tpsc.send(spec.node("SPU").address, M.Move(mov_cmd=1))
     with pytest.raises(ValueError, match="shares no bus"):
-        tpsc.send(spec.node("MCP").address, M.IdAck(address=tpsc.address))  # decision 2
+        tpsc.send(spec.node("MCP").address, M.IdAck(address=tpsc.address))  # docs/decisions.md D2
 
 
 def test_init_calls_reset(spec) -> None:

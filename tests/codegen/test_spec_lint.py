@@ -53,7 +53,7 @@ CASES = [
      "{name: error, type: enum, enum: MMC_ERROR, bits: 4}", "STATUS_ACK_MMC.error: enum MMC_ERROR has value 16, wider than 4 bits"),
     ("unknown_role", M, "from: [NP3, UIC_RCP]", "from: [NP3, UIC_RPC]", None, "MOVE: unknown node role 'UIC_RPC' in `from`"),
     ("not_on_one_bus", M, "    from: [USRC]\n    to: [SPU]", "    from: [USRC]\n    to: [MCP]", None,
-     "XMIT_DATA_USRC: MCP and USRC are not on one bus (decision 2: masters relay between layers)"),
+     "XMIT_DATA_USRC: MCP and USRC are not on one bus (docs/decisions.md D2: masters relay between layers)"),
     ("unknown_count_field", M, "{name: missing, type: node, count: missing_count}", "{name: missing, type: node, count: missing_cnt}", None,
      "POST_REPORT.missing: count refers to 'missing_cnt', which is not an earlier field"),
     ("checksum_check_value", M, "check: 0x29B1", "check: 0x29B2", None,
@@ -84,6 +84,21 @@ CASES = [
      "    subset_of: MOV_CMD\n    values: {TRIPOD: 7}\n    names: [TRIPOD, RIPPLE, WAVE]", "  GAIT:\n",
      "GAIT: needs either `values` or `subset_of` with `names`"),
     ("line_unknown_node", N, 'node: "UIC/RCP"', 'node: "UIC/RCX"', None, "line rcp: unknown node 'UIC/RCX'"),
+    ("reply_to_unknown", M, "    reply_to: POST_QUERY\n", "    reply_to: POST_QUERRY\n", None,
+     "POST_REPORT: reply_to unknown message 'POST_QUERRY'"),
+    ("reply_from_a_non_receiver", M, "    reply_to: ID_REQ\n", "    reply_to: POST_QUERY\n", None,
+     "ID_ACK: NP3, SSC, APU_SDF, UIC_RCP, RLC, USRC, TPSC, IRRC, ISC, TSC, LSC, PSC, JAC do(es) not receive POST_QUERY, "
+     "so cannot be on the `from` side of its reply"),
+    ("two_replies_of_a_role", M, "    from: [NP3, SPU, SSC, APU_SDF, UIC_RCP, RLC]\n    to: [MCP]",
+     "    from: [NP3, SPU, SSC, APU_SDF, UIC_RCP, RLC, MMC]\n    to: [MCP]",
+     "name: STATUS_ACK_MMC\n    seed_name: STATUS_ACK\n    reply_to: STATUS_REQ",
+     "STATUS_ACK_MMC: MMC already answer(s) STATUS_REQ with STATUS_ACK_BUSY"),
+    ("carried_in_unknown", M, "{name: OBJ_BOTH, opcode: 0x50, section: \"3.2.12\", carried_in: XMIT_DATA_TPSC,",
+     "{name: OBJ_BOTH, opcode: 0x50, section: \"3.2.12\", carried_in: XMIT_DATA_TPSX,", None,
+     "OBJ_BOTH: carried_in unknown message 'XMIT_DATA_TPSX'"),
+    ("carried_in_without_its_code", M, "bits: {OBJ_LEFT: 0x10, OBJ_RIGHT: 0x20, OBJ_BOTH: 0x40}",
+     "bits: {OBJ_LEFT: 0x10, OBJ_RIGHT: 0x20, BOTH: 0x40}", "carried_in: XMIT_DATA_TPSC, from: [TPSC], to: [SPU], doc: \"Both",
+     "OBJ_BOTH: XMIT_DATA_TPSC has no flags bit or enum value named OBJ_BOTH to carry it"),
 ]
 
 

@@ -151,3 +151,14 @@ def test_relay_bus_has_no_lead_rule(spec):
     p = sa.arbitration(spec, "first")
     assert p.reflex == "SPU" and p.relay and arbitration.lead_slave(p, "spec") is None
     assert not any(r.name.startswith("lead_") for r in arbitration.build(p, "spec", 3).rules)
+
+
+@pytest.mark.parametrize("bus", ["first", "sensor"])
+def test_fetch_is_labelled_with_the_spec_messages(spec, bus):
+    """The chart's fetch arrows name the bus's fetch_message and each slave's record, as the spec declares them."""
+    p = sa.arbitration(spec, bus)
+    rules = {r.name: r for r in arbitration.build(p, "spec", 2).rules}
+    for s in p.slaves[:2]:
+        grant, record = rules[f"fetched_{s.short}"].msc
+        assert grant.text == spec.buses[bus].fetch_message
+        assert spec.message(record.text).record and spec.node(s.short).role in spec.message(record.text).senders

@@ -19,6 +19,10 @@ OUT_DIR = "generated/python/arachnae_proto"
 COMMENT = "#"
 
 
+# seed 3.2.2-3.2.3: the requests every node answers alike, handled by skeletons/base.py (skeleton.py.j2 skips them)
+COMMON = ("INIT", "ID_REQ", "STATUS_REQ")
+
+
 def camel(name: str) -> str:
     return "".join(part.capitalize() for part in name.lower().split("_"))
 
@@ -212,7 +216,7 @@ def outputs(spec: Spec) -> list[Output]:
     msgs = [view(m) for m in spec.messages]
     roles = []
     for role in spec.roles:
-        status = next((m for m in spec.sends(role) if m.seed_name == "STATUS_ACK"), None)
+        status = spec.reply("STATUS_REQ", role)          # skeletons/base.py answers STATUS_REQ with it
         roles.append({
             "role": role, "module": snake(role), "cls": camel(role) + "Skeleton",
             "receives": [v for v in msgs if role in v.m.receivers],
@@ -223,8 +227,15 @@ def outputs(spec: Spec) -> list[Output]:
     for n in spec.nodes:
         routes[n.address] = {o.address: spec.shared_bus(n, o).name for o in spec.nodes  # type: ignore[union-attr]
                              if o is not n and spec.shared_bus(n, o) is not None}
+    # seed 3.2.2: per fetch message, the records each slave role answers it with (spec `record: true`)
+    fetched: dict[str, dict[str, list[str]]] = {}
+    for bus in spec.buses.values():
+        if bus.fetch_message is not None:
+            by_role = fetched.setdefault(camel(bus.fetch_message), {})
+            for role, records in spec.fetched_records(bus.name).items():
+                by_role.setdefault(role, [camel(m.name) for m in records])
     width = spec.frame.checksum.width
-    ctx = {"errors": ERROR_KINDS, "msgs": msgs, "roles": roles, "tables": log_tables(spec), "crc_fast": crc_fast(spec), "routes": routes,
+    ctx = {"errors": ERROR_KINDS, "msgs": msgs, "fetched": fetched, "common": COMMON, "roles": roles, "tables": log_tables(spec), "crc_fast": crc_fast(spec), "routes": routes,
            "crc_shift": width - 8, "crc_top": 1 << (width - 1), "crc_mask": (1 << width) - 1}
     out = [
         Output("__init__.py", "init.py.j2", ctx),

@@ -14,7 +14,7 @@ from typing import Iterator
 from codegen import names as N
 from codegen.model import Enum, Spec
 
-from . import PyMessage, camel, snake, view
+from . import COMMON, PyMessage, camel, snake, view
 
 # Builtins the generated modules call; a field, class or module of that name would shadow one.
 BUILTINS = frozenset("""
@@ -52,7 +52,6 @@ ENUMS_MODULE = bound_names("enums.py.j2")
 SKELETON_PACKAGE = frozenset({"base", "__init__"})
 SKELETON_MODULE = bound_names("skeleton.py.j2")
 SKELETON_CLASS = bound_names("skeleton_base.py.j2", "    ", attributes=True) | bound_names("skeleton.py.j2", "    ")
-COMMON = ("INIT", "ID_REQ", "STATUS_REQ")   # handled by the base class (skeleton.py.j2 skips them)
 
 
 def rules() -> N.Rules:

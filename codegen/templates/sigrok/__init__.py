@@ -2,7 +2,7 @@
 
 Stacked on sigrok's `uart` decoder, it cuts the bytes of one RS-485 line into
 frames at the bus's idle gap, checks them like the codecs (size by the length
-byte, CRC, opcode, payload length, field ranges) and annotates every header
+byte, CRC, route as a codec without an own address, opcode, payload length, field ranges) and annotates every header
 field and message field at its bytes, or at its bits when it shares a byte.
 It is plain Python for the sigrok interpreter: no arachnae package needed,
 only the tables below (codegen.layout, shared with the Wireshark dissector).
