@@ -498,8 +498,9 @@ def view(spec: Spec) -> dict:
                 rv.id_ack_field = node_fields[0]
             elif mv.name == STATUS_REQ:
                 rv.status_req = mv
+                # the reply is the spec's reply_to, not a name match (issue 16); the lint allows one per role
                 rv.status_ack = _unique_one(
-                    [m for m in messages if m.m.seed_name == STATUS_ACK and role in m.senders], STATUS_ACK, N.of_role(spec, role))
+                    [m for m in messages if m.m.reply_to == STATUS_REQ and role in m.senders], STATUS_ACK, N.of_role(spec, role))
                 if not rv.status_ack.has_fields:
                     raise N.Unsupported(rv.status_ack.origin, "a STATUS_ACK needs a field for the C skeleton to fill")
             else:
