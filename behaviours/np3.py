@@ -147,6 +147,10 @@ class NP3(Runtime, Np3Skeleton):
         self.next_plan = 0.0
         self.goal: tuple[float, float] | None = None
         self.routes_planned = 0               # routes planned over the topological map (3.3.2)
+        self.target: tuple[float, float] | None = None   # the frontier the routes lead to (route_to_frontier)
+        self.target_left = math.inf           # ... the shortest route to it so far, m
+        self.target_closer_at = 0.0           # ... when that last shortened
+        self.given_up: list[tuple[float, float]] = []   # frontiers explored, refuted or not reached: no revisits
         self.visited: set[tuple[int, int]] = set()
         self.last_cell: tuple[int, int] | None = None
         self.every(T.NP3_PERIOD_S, self.tick)
@@ -235,7 +239,7 @@ class NP3(Runtime, Np3Skeleton):
         self.map.plan = []
         if self.cfg.task == "seek_light":          # searching for a light it cannot see: the nearest unknown
             # the widest opening onto the unknown first, round walls by the map (a lamp behind a wall)
-            self.goal = self.route_to_frontier(x, y, T.NP3_SEEK_FRONTIER_WEIGHT_M)
+            self.goal = self.route_to_frontier(x, y, now, T.NP3_SEEK_FRONTIER_WEIGHT_M)
             if self.goal is not None:
                 self.layers.sense(goal=self.goal)
                 return
@@ -257,23 +261,50 @@ class NP3(Runtime, Np3Skeleton):
             length = min(best[2] - T.NP3_EXPLORE_MARGIN_M, T.NP3_EXPLORE_GOAL_M)
             self.goal = (x + length * math.cos(best[1]), y + length * math.sin(best[1]))
         else:
-            self.goal = self.route_to_frontier(x, y)
+            self.goal = self.route_to_frontier(x, y, now)
         self.layers.sense(goal=self.goal)
 
-    def route_to_frontier(self, x: float, y: float, size_weight: float = 0.0) -> tuple[float, float] | None:
-        """seed 3.3.2: plan over the rebuilt topological map to the nearest frontier (`size_weight`: m of path a
-        cell of frontier is worth, TopoMap.frontier); its first waypoint."""
+    def route_to_frontier(self, x: float, y: float, now: float, size_weight: float = 0.0) \
+            -> tuple[float, float] | None:
+        """seed 3.3.2: plan over the rebuilt topological map to a frontier and keep to it; its first waypoint.
+
+        The frontier (the nearest, `size_weight`: m of path a cell of it is worth, TopoMap.frontier) is the
+        target of every replan (the map changed, so may the route) until it is explored (no frontier cell
+        left within NP3_PLAN_EXCLUDE_M), refuted (no route leads there) or not approached (the route not
+        NP3_PLAN_PROGRESS_M shorter for NP3_PLAN_PATIENCE_S). Then it is given up, frontier cells near it no
+        longer count (no revisits), and the next frontier is chosen. Choosing afresh at every replan swapped
+        between frontiers and reached none (light_behind_wall, issue 17).
+        """
         self.map.rebuild()
-        frontier = self.map.frontier(x, y, min_size=T.NP3_PLAN_MIN_FRONTIER, min_path_m=T.NP3_PLAN_MIN_PATH_M,
-                                     size_weight=size_weight)
-        route = self.map.route((x, y), (frontier.x, frontier.y)) if frontier is not None else None
-        while route and math.dist(route[0], (x, y)) < T.NP3_GOAL_REACHED_M:
-            route.pop(0)
-        self.map.plan = route or []
-        if not route:
-            return None
-        self.routes_planned += 1
-        return route[0]
+        for _choice in range(2):                  # the committed target, else (given up) one new one
+            if self.target is None:
+                frontier = self.map.frontier(x, y, min_size=T.NP3_PLAN_MIN_FRONTIER, min_path_m=T.NP3_PLAN_MIN_PATH_M,
+                                             size_weight=size_weight, exclude=self.given_up,
+                                             exclude_m=T.NP3_PLAN_EXCLUDE_M)
+                if frontier is None:
+                    break
+                self.target, self.target_left, self.target_closer_at = (frontier.x, frontier.y), math.inf, now
+            route = self.map.route((x, y), self.target) or []
+            while route and math.dist(route[0], (x, y)) < T.NP3_GOAL_REACHED_M:
+                route.pop(0)
+            left = self.map.length((x, y), route)
+            if left < self.target_left - T.NP3_PLAN_PROGRESS_M:
+                self.target_left, self.target_closer_at = left, now
+            if not route or not self.map.frontier_near(*self.target, T.NP3_PLAN_EXCLUDE_M) \
+                    or now - self.target_closer_at > T.NP3_PLAN_PATIENCE_S:
+                self.given_up.append(self.target)
+                self.target = None
+                continue
+            self.map.plan = route
+            self.routes_planned += 1
+            return route[0]
+        self.map.plan = []
+        return None
+
+    def map_changed(self) -> None:
+        """seed 3.3.2: a barrier joined the map: plan again within NP3_PLAN_CHANGED_S (not at every record of a
+        slope the body stands on: one rebuild per that time at most)."""
+        self.next_plan = min(self.next_plan, self.now + T.NP3_PLAN_CHANGED_S)
 
     def mark_visited(self, x: float, y: float) -> None:
         """The map cells within NP3_EXPLORE_SEEN_M of the dead-reckoned path (what exploring has covered)."""
@@ -380,6 +411,7 @@ class NP3(Runtime, Np3Skeleton):
                 fx, fy = self.geo.neutral_foot(leg) if leg in self.geo.legs else (self.geo.hip_x[0], 0.0)
                 self.echo(fx, fy, 0.0, 0.0)          # the edge joins the local memory (the motion check) ...
                 self.map.grid.mark_barrier(*self.at_body(fx, fy))   # ... and the map: the pit is part of it (3.3.2)
+                self.map_changed()
                 self.bump("pit", fx, fy)
             elif error == _BLOCKED:
                 self.bump("leg_blocked", self.geo.side(leg) if leg in self.geo.legs else 0.0)
@@ -418,6 +450,7 @@ class NP3(Runtime, Np3Skeleton):
             bx, by = ahead * ux / n, ahead * uy / n
             self.echo(bx, by, 0.0, 0.0)
             self.map.grid.mark_barrier(*self.at_body(bx, by))
+        self.map_changed()
 
     def light(self, lux: float) -> None:
         self.lux.append(lux)

@@ -357,6 +357,11 @@ class TopoMap:
                     heapq.heappush(todo, (d + h(by_id[n]), n))
         return None
 
+    @staticmethod
+    def length(start: tuple[float, float], route: Sequence[tuple[float, float]]) -> float:
+        """The length (m) of a route's waypoints walked from `start`."""
+        return sum(math.dist(a, b) for a, b in zip([start, *route], route))
+
     def coverage(self) -> float:
         """Share of the room polygon's cells that some beam has crossed or hit (0..1)."""
         if not self.room:
@@ -370,14 +375,35 @@ class TopoMap:
                     seen += g.seen[j * g.nx + i]
         return seen / total if total else 0.0
 
+    def _open_unknown(self, i: int, j: int) -> bool:
+        """An unknown cell with no occupied neighbour (one next to an occupied cell is most likely a wall cell
+        a grazing beam missed)."""
+        g = self.grid
+        return g.inside(i, j) and g.state(i, j) == UNKNOWN and all(
+            g.state(i + di, j + dj) != OCCUPIED for di, dj in _N8)
+
+    def is_frontier(self, c: tuple[int, int]) -> bool:
+        """A free cell bordering open unknown space."""
+        return self.grid.state(*c) == FREE and any(self._open_unknown(c[0] + di, c[1] + dj) for di, dj in _N8)
+
+    def frontier_near(self, x: float, y: float, radius_m: float) -> bool:
+        """Some frontier cell lies within `radius_m` of (x, y): a frontier chosen there is not yet explored."""
+        g = self.grid
+        (i0, j0), (i1, j1) = g.cell(x - radius_m, y - radius_m), g.cell(x + radius_m, y + radius_m)
+        return any(self.is_frontier((i, j)) and math.dist(g.centre(i, j), (x, y)) <= radius_m
+                   for j in range(j0, j1 + 1) for i in range(i0, i1 + 1))
+
     def frontier(self, x: float, y: float, min_size: int = 5, min_path_m: float = 0.0,
-                 size_weight: float = 0.0) -> Frontier | None:
+                 size_weight: float = 0.0, exclude: Sequence[tuple[float, float]] = (),
+                 exclude_m: float = 0.0) -> Frontier | None:
         """The nearest (by free path) cluster of free cells bordering open unknown space; None when explored.
 
         Clusters smaller than `min_size` cells are gaps between diverging beams,
         not frontiers; cells nearer than `min_path_m` are where the robot already is.
         With `size_weight` a cluster's path counts that many metres less per cell of its edge (a wide opening
         onto unknown space is worth a longer walk than a sliver, the usual gain-minus-cost frontier choice).
+        Cells within `exclude_m` of an `exclude` point do not count: frontiers the robot gave up on (no
+        revisits).
         """
         g = self.grid
         start = g.cell(x, y)
@@ -393,15 +419,10 @@ class TopoMap:
                     dist[n] = dist[(i, j)] + g.res * math.hypot(di, dj)
                     queue.append(n)
 
-        def open_unknown(i: int, j: int) -> bool:
-            # an unknown cell next to an occupied one is most likely a wall cell a grazing beam missed
-            return g.inside(i, j) and g.state(i, j) == UNKNOWN and all(
-                g.state(i + di, j + dj) != OCCUPIED for di, dj in _N8)
+        def excluded(c: tuple[int, int]) -> bool:
+            return any(math.dist(g.centre(*c), p) < exclude_m for p in exclude)
 
-        def is_frontier(c: tuple[int, int]) -> bool:
-            return g.state(*c) == FREE and any(open_unknown(c[0] + di, c[1] + dj) for di, dj in _N8)
-
-        cells = {c for c in dist if dist[c] >= min_path_m and is_frontier(c)}
+        cells = {c for c in dist if dist[c] >= min_path_m and self.is_frontier(c) and not excluded(c)}
         best: Frontier | None = None
         while cells:
             seed = min(cells)
