@@ -32,7 +32,7 @@ from behaviours import tuning as T
 from behaviours.np3_layers import (AVOIDANCE, REFLEXES, Tuning, body_frame, closing_in, np3_network, safe_instead,
                                    steepness_deg, uphill)
 from behaviours.runtime import Runtime
-from behaviours.topomap import OCCUPIED, OccupancyGrid, Reading, TopoMap, ray_cells
+from behaviours.topomap import OCCUPIED, FrontierTarget, OccupancyGrid, Reading, TopoMap, ray_cells
 from behaviours.units import XMIT_DATA_OF, Quantizer, from_record_byte, quantizer
 
 _VALUE, _ALARM, _STATUS = int(RecordKind.VALUE), int(RecordKind.ALARM), int(RecordKind.STATUS)
@@ -147,10 +147,7 @@ class NP3(Runtime, Np3Skeleton):
         self.next_plan = 0.0
         self.goal: tuple[float, float] | None = None
         self.routes_planned = 0               # routes planned over the topological map (3.3.2)
-        self.target: tuple[float, float] | None = None   # the frontier the routes lead to (route_to_frontier)
-        self.target_left = math.inf           # ... the shortest route to it so far, m
-        self.target_closer_at = 0.0           # ... when that last shortened
-        self.given_up: list[tuple[float, float]] = []   # frontiers explored, refuted or not reached: no revisits
+        self.frontier_target = FrontierTarget(T.NP3_PLAN_EXCLUDE_M, T.NP3_PLAN_PROGRESS_M, T.NP3_PLAN_PATIENCE_S)
         self.visited: set[tuple[int, int]] = set()
         self.last_cell: tuple[int, int] | None = None
         self.every(T.NP3_PERIOD_S, self.tick)
@@ -266,40 +263,17 @@ class NP3(Runtime, Np3Skeleton):
 
     def route_to_frontier(self, x: float, y: float, now: float, size_weight: float = 0.0) \
             -> tuple[float, float] | None:
-        """seed 3.3.2: plan over the rebuilt topological map to a frontier and keep to it; its first waypoint.
-
-        The frontier (the nearest, `size_weight`: m of path a cell of it is worth, TopoMap.frontier) is the
-        target of every replan (the map changed, so may the route) until it is explored (no frontier cell
-        left within NP3_PLAN_EXCLUDE_M), refuted (no route leads there) or not approached (the route not
-        NP3_PLAN_PROGRESS_M shorter for NP3_PLAN_PATIENCE_S). Then it is given up, frontier cells near it no
-        longer count (no revisits), and the next frontier is chosen. Choosing afresh at every replan swapped
-        between frontiers and reached none (light_behind_wall, issue 17).
-        """
+        """seed 3.3.2: a route over the rebuilt topological map to the frontier kept as the target
+        (FrontierTarget: the nearest, a cell of it worth `size_weight` m of path, until explored, refuted or
+        not approached); its first waypoint."""
         self.map.rebuild()
-        for _choice in range(2):                  # the committed target, else (given up) one new one
-            if self.target is None:
-                frontier = self.map.frontier(x, y, min_size=T.NP3_PLAN_MIN_FRONTIER, min_path_m=T.NP3_PLAN_MIN_PATH_M,
-                                             size_weight=size_weight, exclude=self.given_up,
-                                             exclude_m=T.NP3_PLAN_EXCLUDE_M)
-                if frontier is None:
-                    break
-                self.target, self.target_left, self.target_closer_at = (frontier.x, frontier.y), math.inf, now
-            route = self.map.route((x, y), self.target) or []
-            while route and math.dist(route[0], (x, y)) < T.NP3_GOAL_REACHED_M:
-                route.pop(0)
-            left = self.map.length((x, y), route)
-            if left < self.target_left - T.NP3_PLAN_PROGRESS_M:
-                self.target_left, self.target_closer_at = left, now
-            if not route or not self.map.frontier_near(*self.target, T.NP3_PLAN_EXCLUDE_M) \
-                    or now - self.target_closer_at > T.NP3_PLAN_PATIENCE_S:
-                self.given_up.append(self.target)
-                self.target = None
-                continue
-            self.map.plan = route
-            self.routes_planned += 1
-            return route[0]
-        self.map.plan = []
-        return None
+        self.map.plan = self.frontier_target.route(self.map, x, y, now, T.NP3_GOAL_REACHED_M,
+                                                   min_size=T.NP3_PLAN_MIN_FRONTIER,
+                                                   min_path_m=T.NP3_PLAN_MIN_PATH_M, size_weight=size_weight)
+        if not self.map.plan:
+            return None
+        self.routes_planned += 1
+        return self.map.plan[0]
 
     def map_changed(self) -> None:
         """seed 3.3.2: a barrier joined the map: plan again within NP3_PLAN_CHANGED_S (not at every record of a

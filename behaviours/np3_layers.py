@@ -538,20 +538,26 @@ class TaskModule:
             return
         self.light_seq = light[0]
         self.samples = (self.samples + [light[1:]])[-self.t.light_samples:]
-        logs = [s[2] for s in self.samples]
-        self.dimmest = min(self.dimmest, logs[-1])
-        if self.dark_level is None and len(logs) >= self.t.light_samples \
-                and max(logs) < min(logs) + self.t.light_flat_log and max(logs) < self.dimmest + self.t.light_flat_log:
-            self.dark_level = max(logs)               # no light to climb: the gradient so far was noise
-            self.gradient = None
-        elif self.dark_level is not None and logs[-1] >= self.dark_level + self.t.light_flat_log:
-            self.dark_level = None                    # a light shows: fit afresh, with no prior from the noise
+        if self.task == "seek_light":                 # avoiding light, a flat reading is where it wants to be
+            self._darkness()
         if self.dark_level is not None:
             return
         fit = light_gradient(self.samples, self.t.light_min_spread_m, self.gradient)
         if fit is not None and self.gradient is None:
             self.plan = None                          # the probe has done its job: head for the light now
         self.gradient = fit or self.gradient
+
+    def _darkness(self) -> None:
+        """Enter or leave the dark state (dark()) with the newest sample."""
+        logs = [s[2] for s in self.samples]
+        self.dimmest = min(self.dimmest, logs[-1])
+        flat = self.t.light_flat_log
+        if self.dark_level is None and len(logs) >= self.t.light_samples \
+                and max(logs) < min(logs) + flat and max(logs) < self.dimmest + flat:
+            self.dark_level = max(logs)               # no light to climb: the gradient so far was noise
+            self.gradient = None
+        elif self.dark_level is not None and logs[-1] >= self.dark_level + flat:
+            self.dark_level = None                    # a light shows: fit afresh, with no prior from the noise
 
     def dark(self) -> bool:
         """No light to follow: a full set of samples spanned less than light_flat_log (a few LSC steps of

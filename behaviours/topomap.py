@@ -24,7 +24,7 @@ from __future__ import annotations
 import heapq
 import math
 from collections import deque
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterable, Sequence
 
@@ -484,11 +484,55 @@ class TopoMap:
         return out
 
 
+@dataclass
+class FrontierTarget:
+    """seed 3.3.2: the frontier the robot's routes lead to, kept from one replan to the next.
+
+    Choosing the nearest frontier afresh at every replan swapped between frontiers as the map grew and
+    reached none (light_behind_wall, issue 17). So the target is kept, and routed to again on the rebuilt
+    map at every replan (the map changed, so may the route), until it is explored (no frontier cell left
+    within `exclude_m`), refuted (no route leads there) or not approached (its route not `progress_m`
+    shorter for `patience_s`). Then it is given up, frontier cells near it no longer count (no revisits)
+    and the next frontier is chosen.
+    """
+
+    exclude_m: float
+    progress_m: float
+    patience_s: float
+    target: tuple[float, float] | None = None
+    left_m: float = math.inf                  # the shortest route to the target so far
+    closer_at: float = 0.0                    # when that last shortened
+    given_up: list[tuple[float, float]] = field(default_factory=list)
+
+    def route(self, topo: TopoMap, x: float, y: float, now: float, reached_m: float, min_size: int = 5,
+              min_path_m: float = 0.0, size_weight: float = 0.0) -> list[tuple[float, float]]:
+        """The route from (x, y) to the target over `topo` (rebuilt by the caller), waypoints nearer than
+        `reached_m` dropped; [] when no frontier is left to explore. The frontier arguments: TopoMap.frontier."""
+        for _choice in range(2):                  # the kept target, else (given up) one new one
+            if self.target is None:
+                f = topo.frontier(x, y, min_size=min_size, min_path_m=min_path_m, size_weight=size_weight,
+                                  exclude=self.given_up, exclude_m=self.exclude_m)
+                if f is None:
+                    return []
+                self.target, self.left_m, self.closer_at = (f.x, f.y), math.inf, now
+            route = topo.route((x, y), self.target) or []
+            while route and math.dist(route[0], (x, y)) < reached_m:
+                route.pop(0)
+            left = topo.length((x, y), route)
+            if left < self.left_m - self.progress_m:
+                self.left_m, self.closer_at = left, now
+            if route and topo.frontier_near(*self.target, self.exclude_m) and now - self.closer_at <= self.patience_s:
+                return route
+            self.given_up.append(self.target)
+            self.target = None
+        return []
+
+
 def full_scan(x: float, y: float, heading_deg: float, ranges: Sequence[float | None],
               step_deg: float = 1.0) -> list[Reading]:
     """Readings of one USRC sweep (seed 3.2.11: 360 deg at 1 deg) from `ranges[k]` at head angle k*step."""
     return [Reading(x, y, heading_deg, k * step_deg, d) for k, d in enumerate(ranges)]
 
 
-__all__ = ["Reading", "Place", "Frontier", "OccupancyGrid", "TopoMap", "full_scan", "line_cells", "ray_cells",
+__all__ = ["Reading", "Place", "Frontier", "FrontierTarget", "OccupancyGrid", "TopoMap", "full_scan", "line_cells", "ray_cells",
            "point_in_polygon", "UNKNOWN", "FREE", "OCCUPIED", "USRC_MAX_RANGE_M", "USRC_MIN_RANGE_M"]
