@@ -482,4 +482,4 @@ class NP3(Runtime, Np3Skeleton):
         (out / "control.tsv").write_text("\n".join(rows) + "\n")
         (out / "wiring.txt").write_text(self.layers.wiring_table() + "\n")
         self.map.rebuild()
-        self.map.save_png(out / "topomap.png")
+        self.map.save_png(out / "topomap.png", given_up=self.frontier_target.given_up)

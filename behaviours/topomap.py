@@ -446,8 +446,10 @@ class TopoMap:
         return best
 
     # -- picture --------------------------------------------------------------------
-    def save_png(self, path: str | Path, px_per_cell: int = 4) -> Path:
-        """Grid (unknown grey, free white, occupied black), room outline, edges, places, robot path."""
+    def save_png(self, path: str | Path, px_per_cell: int = 4,
+                 given_up: Sequence[tuple[float, float]] = ()) -> Path:
+        """Grid (unknown grey, free white, occupied black), room outline, edges, places, robot path, the plan
+        (green, to a square at its goal) and frontiers given up (FrontierTarget, purple crosses)."""
         from PIL import Image, ImageDraw
 
         g, s = self.grid, px_per_cell
@@ -479,6 +481,10 @@ class TopoMap:
             draw.line(pts, fill=(0, 170, 60), width=3)
             (gx, gy), r = pts[-1], max(5, 2 * s)
             draw.rectangle((gx - r, gy - r, gx + r, gy + r), outline=(0, 170, 60), width=2)
+        for p in given_up:
+            (cx, cy), r = px(*p), max(4, s)
+            draw.line((cx - r, cy - r, cx + r, cy + r), fill=(150, 40, 170), width=2)
+            draw.line((cx - r, cy + r, cx + r, cy - r), fill=(150, 40, 170), width=2)
         out = Path(path)
         img.save(out, format="PNG")
         return out

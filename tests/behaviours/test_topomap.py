@@ -187,9 +187,11 @@ def test_a_route_goes_round_through_the_door_and_never_through_the_wall(tmp_path
     crossing = [(a, b) for a, b in legs if (a[0] < 4) != (b[0] < 4)]
     assert crossing and all(1.5 < (a[1] + b[1]) / 2 < 2.5 for a, b in crossing)    # through the door (y 1.5..2.5)
     opened.plan = route
-    out = opened.save_png(tmp_path / "plan.png")
+    out = opened.save_png(tmp_path / "plan.png", given_up=[(1.0, 1.0)])
     img = Image.open(out).convert("RGB")
     assert any(img.getpixel((x, y)) == (0, 170, 60) for x in range(img.width) for y in range(0, img.height, 2))
+    i, j = opened.grid.cell(1.0, 1.0)                              # a frontier given up: a cross there
+    assert img.getpixel((i * 4 + 2, (opened.grid.ny - 1 - j) * 4 + 2)) == (150, 40, 170)
 
 
 def test_pits_found_are_barriers_and_the_route_takes_their_one_gap_then_replans_when_it_closes():
