@@ -245,13 +245,16 @@ def test_frontier_target_is_kept_until_not_approached_then_given_up_for_good():
     route = ft.route(m, 1.5, 1.0, 0.0, reached_m=0.2, min_size=3)
     first = ft.target
     assert route and first is not None and first[0] < 0.6 and route[-1] == first   # the near (left) end
-    route = ft.route(m, 3.8, 1.0, 10.0, reached_m=0.2, min_size=3)                  # now the right end is nearer
+    route = ft.route(m, 2.8, 1.0, 10.0, reached_m=0.2, min_size=3)                  # now the right end is nearer
     assert ft.target == first and route[-1] == first                                  # kept
-    route = ft.route(m, 3.8, 1.0, 41.0, reached_m=0.2, min_size=3)                  # not approached for 41 s
+    route = ft.route(m, 2.8, 1.0, 41.0, reached_m=0.2, min_size=3)                  # not approached for 41 s
     assert ft.given_up == [first] and ft.target is not None and ft.target[0] > 3.5 and route[-1] == ft.target
     ft.target = None                                                                  # a fresh choice near the
     ft.route(m, 1.5, 1.0, 50.0, reached_m=0.2, min_size=3)                          # left end: not the given-up one
     assert ft.target is not None and ft.target[0] > 3.5
+    right = ft.target
+    ft.route(m, right[0] - 0.4, right[1], 60.0, reached_m=0.2, min_size=3)          # within 0.5 m: reached
+    assert ft.given_up == [first, right] and ft.target != right
 
 
 def test_frontier_target_replans_round_pits_found_on_the_way_and_ends_when_explored():
