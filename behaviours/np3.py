@@ -145,6 +145,7 @@ class NP3(Runtime, Np3Skeleton):
         self.records = 0
         self.lux: list[float] = []
         self.next_plan = 0.0
+        self.planned_at = -math.inf           # the last full plan (a rebuilt map): at most one per NP3_PLAN_CHANGED_S
         self.goal: tuple[float, float] | None = None
         self.routes_planned = 0               # routes planned over the topological map (3.3.2)
         self.frontier_target = FrontierTarget(T.NP3_PLAN_EXCLUDE_M, T.NP3_PLAN_PROGRESS_M, T.NP3_PLAN_PATIENCE_S)
@@ -232,6 +233,9 @@ class NP3(Runtime, Np3Skeleton):
                 self.goal = route[0]
                 self.layers.sense(goal=self.goal)
                 return
+        if now < self.planned_at + T.NP3_PLAN_CHANGED_S:
+            return                                 # a goal reached at once (a short ray): not a rebuild every tick
+        self.planned_at = now
         self.next_plan = now + T.NP3_EXPLORE_PLAN_S
         self.map.plan = []
         if self.cfg.task == "seek_light":          # searching for a light it cannot see: the nearest unknown

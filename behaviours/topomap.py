@@ -500,7 +500,8 @@ class FrontierTarget:
     frontier by a wall may lie where the body cannot stand, light_behind_wall seed 4 spent 40 s 0.45 m from
     one), explored (no frontier cell left within `exclude_m`), refuted (no route leads there) or not
     approached (its route not `progress_m` shorter for `patience_s`). Then it is given up, frontier cells near it no longer count (no revisits)
-    and the next frontier is chosen.
+    and the next frontier is chosen. When every frontier left has been given up, they count again (the
+    map has grown since: start over rather than stop).
     """
 
     exclude_m: float
@@ -515,10 +516,13 @@ class FrontierTarget:
               min_path_m: float = 0.0, size_weight: float = 0.0) -> list[tuple[float, float]]:
         """The route from (x, y) to the target over `topo` (rebuilt by the caller), waypoints nearer than
         `reached_m` dropped; [] when no frontier is left to explore. The frontier arguments: TopoMap.frontier."""
-        for _choice in range(2):                  # the kept target, else (given up) one new one
+        for _choice in range(3):                  # the kept target, else (given up) a new one, else start over
             if self.target is None:
                 f = topo.frontier(x, y, min_size=min_size, min_path_m=min_path_m, size_weight=size_weight,
                                   exclude=self.given_up, exclude_m=self.exclude_m)
+                if f is None and self.given_up:       # all explored or given up: the map has grown since,
+                    self.given_up.clear()             # so start over rather than stop
+                    continue
                 if f is None:
                     return []
                 self.target, self.left_m, self.closer_at = (f.x, f.y), math.inf, now
