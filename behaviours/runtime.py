@@ -184,6 +184,14 @@ class Runtime:
                  len(q))
         q.insert(i, req)
 
+    def waiting(self, dst: int, msg: type[Message], priority: int = 0) -> bool:
+        """A transaction sending a `msg` to `dst`, of `priority` or higher (Runtime.request), is queued on the
+        mastered bus and not yet on the wire."""
+        link = self.links[self.master_bus]  # type: ignore[index]
+        cur = link.current
+        return any(r.dst == dst and type(r.msg) is msg and r.priority >= priority
+                   for r in ([cur] if cur is not None and not cur.sent else []) + list(link.queue))
+
     def when_idle(self, fn: Callable[[], Any]) -> None:
         """Run fn once every transaction queued so far on the mastered bus has finished."""
         link = self.links[self.master_bus]  # type: ignore[index]
@@ -215,6 +223,13 @@ class Runtime:
             # spec arbitration (scope all): after a corrupt frame the slaves own the window's slots; the
             # arbitration model's master only listens then, and a master frame in a slot costs a slave its turn
             self.hw.after(quiet, self._transmit, link, serial)
+            return
+        if self._scope_all(link.bus) and self.hw.line_idle_s(link.bus) == 0.0:
+            # spec arbitration (scope all): hand the frame to the line only once the frame on it has ended. Queued
+            # behind a collision it went out in slot 0 of the window that collision opened, and a request begun
+            # less than a bit before the resend met it: each cost every slave a window (worst_contention seed 6:
+            # LSC, PSC past K)
+            self.hw.after(link.timing.char_s, self._transmit, link, serial)
             return
         req.sent = True
         if req.dst == BROADCAST:                  # seed 3.2.1: 0xFF, every node of the bus

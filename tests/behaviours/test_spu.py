@@ -6,6 +6,7 @@ from arachnae_proto.enums import RangeStatus, RecordKind, TpscContact
 from arachnae_proto.network import ADDRESS_OF as A
 
 from behaviours import tuning as T
+from behaviours.runtime import BusTiming
 from behaviours.units import quantizer
 from tests.behaviours.rig import Rig
 
@@ -173,3 +174,49 @@ def test_asked_for_its_id_again_after_reporting_the_spu_runs_a_new_post(spec):
     assert rig.node.debug_metrics()["posts"] == 2
     polls_after = [t for t, f in rig.frames(M.XmitData) if t > 7.0]
     assert polls_after                                      # polling resumed after the new POST
+
+
+def test_a_sensor_announcing_again_before_its_fetch_goes_out_is_fetched_once(spec):
+    """seed 3.2.2 / arbitration model: one request per slave. DATA_RDYs while the sonar's fetch still waits for the
+    line add none (the free-running USRC had piled up nine, every other sensor past K); an urgent fetch is not
+    folded into an ordinary poll of the same sensor still waiting (that one comes last)."""
+    rig, _ = spu(spec)
+    t = rig.board.t
+    for k in range(3):
+        rig.inject(t + 0.001 * k, A["USRC"], M.DataRdy())
+    rig.node.request(A["LSC"], M.XmitData(), (M.XmitDataLsc,))          # an ordinary poll, waiting
+    rig.inject(t + 0.003, A["LSC"], M.DataRdy())                        # an alarm: fetched as urgent
+    rig.run(t + 0.003)
+    assert rig.node.waiting(A["LSC"], M.XmitData, 1)
+    rig.run(t + 1.0)
+    assert len([1 for at, _f in rig.frames(M.XmitData, A["USRC"]) if at >= t]) == 1
+    assert rig.node.debug_metrics()["coalesced"] == 2
+
+
+def test_the_master_does_not_send_a_frame_queued_behind_a_collision_into_the_window_it_opens(spec):
+    """spec arbitration (scope all): after a corrupt frame the slaves own the window's slots and the master keeps
+    off the line (Runtime._transmit). A fetch whose defer ended while a collision was on the line went out in slot 0,
+    meeting the rank-0 TPSC (worst_contention seed 6); it waits for the window and the master's defer."""
+    rig, _ = spu(spec)
+    node, b = rig.node, rig.board
+    t = BusTiming("sensor")
+    link = node.links["sensor"]
+    asked: list[float] = []
+
+    def watch() -> None:
+        """Once the fetch waits out its defer, a collision holds the line past the defer and ends heard corrupt."""
+        cur = link.current
+        if cur is None or cur.dst != A["ISC"] or cur.sent:
+            b.after(t.bit_s, watch)
+            return
+        asked.append(b.t)
+        b.busy_until["sensor"] = end = b.t + spec.protocol.master_defer_slots * t.slot_s + t.char_s
+        b.after(end - b.t, node.on_line_frame, "sensor", b"\x04\x00\x44\x00\x00\x00")
+
+    node.request(A["ISC"], M.XmitData(), (M.XmitDataIsc,), urgent=True)
+    watch()
+    rig.run(b.t + 2.0)
+    end = asked[0] + spec.protocol.master_defer_slots * t.slot_s + t.char_s
+    window = len(node.net.requesters["sensor"]) * node.net.backoff_slots * t.slot_s
+    first = min(at for at, f in rig.frames(M.XmitData, A["ISC"]) if at >= asked[0])
+    assert first >= end + window + spec.protocol.master_defer_slots * t.slot_s - 1e-9
