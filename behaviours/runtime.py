@@ -224,13 +224,6 @@ class Runtime:
             # arbitration model's master only listens then, and a master frame in a slot costs a slave its turn
             self.hw.after(quiet, self._transmit, link, serial)
             return
-        if self._scope_all(link.bus) and self.hw.line_idle_s(link.bus) == 0.0:
-            # spec arbitration (scope all): hand the frame to the line only once the frame on it has ended. Queued
-            # behind a collision it went out in slot 0 of the window that collision opened, and a request begun
-            # less than a bit before the resend met it: each cost every slave a window (worst_contention seed 6:
-            # LSC, PSC past K)
-            self.hw.after(link.timing.char_s, self._transmit, link, serial)
-            return
         req.sent = True
         if req.dst == BROADCAST:                  # seed 3.2.1: 0xFF, every node of the bus
             link.frame = self.broadcast(link.bus, req.msg)  # type: ignore[attr-defined]
