@@ -85,6 +85,7 @@ class SpuDebug(TypedDict):
     ignored: int
     silent: int
     untrusted_values: int
+    coalesced: int                  # DATA_RDYs whose fetch was still waiting (one request per slave)
     values: dict[str, int]          # role -> records of values forwarded
     status: dict[str, int]          # role -> its status code
     posts: int
@@ -106,7 +107,7 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
         self.polling = False
         self.cycle_i = self.status_i = 0
         self.next_status = 0.0
-        self.counts = {"value": 0, "alarm": 0, "status": 0, "ignored": 0, "silent": 0, "untrusted": 0}
+        self.counts = {"value": 0, "alarm": 0, "status": 0, "ignored": 0, "silent": 0, "untrusted": 0, "coalesced": 0}
         self.values: dict[str, int] = {}
         self.run_post(self.post_done)
 
@@ -174,6 +175,14 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
         role = NODES[src].role
         if role not in XMIT_DATA_OF or role not in self.live:
             return
+        # spec reflexes (seed 5.2): a reflex source's data is fetched before anything still waiting out its defer
+        priority = max(PRIORITY_REFLEX if self.net.reflex_from(src) is not None else 0, 1)
+        if self.waiting(src, M.XmitData, priority):
+            # seed 3.2.2 / arbitration model: one request per slave, served in the order they got through. An urgent
+            # fetch still waiting gets the newest data; queueing one per DATA_RDY let the free-running USRC pile up
+            # nine and every other sensor wait behind them (worst_contention seed 6: past K on the sensor bus)
+            self.counts["coalesced"] += 1
+            return
         if role in self.free_run:
             if self.status.get(role, _IN_ORDER) != _IN_ORDER:
                 self.counts["ignored"] += 1       # seed 6.2: an untrustworthy sensor's data is ignored
@@ -185,10 +194,8 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
         if role in RANGE:                          # its status first: is the data to be trusted (6.2)
             self.request(src, M.StatusReq(), (STATUS_OF[role],), lambda s, m, role=role: self.set_status(role, m.status),
                          lambda role=role: self.missed(role), urgent=True)
-        # spec reflexes (seed 5.2): a reflex source's data is fetched before anything still waiting out its defer
         self.request(src, M.XmitData(), (XMIT_DATA_OF[role],), lambda s, m, role=role: self.got(role, m, event),
-                     lambda role=role: self.missed(role), urgent=True,
-                     priority=PRIORITY_REFLEX if self.net.reflex_from(src) is not None else 0)
+                     lambda role=role: self.missed(role), priority=priority)
 
     # --- what the sensors said -------------------------------------------------------------
     def set_status(self, role: str, code: int) -> None:
@@ -269,6 +276,7 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
         """Records forwarded per kind, data ignored (6.2), sensors declared silent, and the status of each."""
         return {"records": {k: self.counts[k] for k in ("value", "alarm", "status")},
                 "ignored": self.counts["ignored"], "silent": self.counts["silent"],
-                "untrusted_values": self.counts["untrusted"], "values": dict(sorted(self.values.items())),
+                "untrusted_values": self.counts["untrusted"], "coalesced": self.counts["coalesced"],
+                "values": dict(sorted(self.values.items())),
                 "status": {r: self.status.get(r, _IN_ORDER) for r in self.live},
                 "posts": self.post_runs}

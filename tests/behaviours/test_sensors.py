@@ -1,11 +1,14 @@
 """Sensor controllers (seed 3.2.11-3.2.17): the three-plus-three rule, SET_ALARM limits, free run."""
 from __future__ import annotations
 
+import pytest
+
 from arachnae_proto import messages as M
 from arachnae_proto.enums import RangeStatus
 from arachnae_proto.network import ADDRESS_OF as A
 
 from behaviours import tuning as T
+from behaviours.runtime import BusTiming
 from behaviours.units import quantizer
 from tests.behaviours.rig import Rig
 
@@ -257,3 +260,22 @@ def test_the_spu_request_carrying_a_contact_leads_an_ordinary_one_on_the_first_b
     slot_s = (spec.frame_time_us("first", 0) + first.frame_gap_us) * 1e-6      # spec arbitration.slot
     assert 1.0 + first.frame_gap_us * 1e-6 <= starts["SPU"] < 1.0 + spec.protocol.master_defer_slots * slot_s
     assert starts["NP3"] - starts["SPU"] >= lead
+
+
+def test_a_slave_does_not_start_its_request_at_the_very_end_of_its_backoff_slot(spec):
+    """seed 3.2.2 / spec address_backoff (scope all): after a corrupt frame the rank-0 SPU may start only inside
+    slot 0 of the window. frame_loss seed 7 had it start 1e-14 s short of slot 1 (float noise), which the line
+    and the trace validator read as slot 1, the next rank's; at the slot's last bit it waits for the window's end."""
+    rig = Rig(spec, "SPU", A["SPU"])
+    node, b = rig.node, rig.board
+    assert node.rank("first") == 0
+    t = BusTiming("first")
+    step = spec.arbitration[spec.buses["first"].arbitration]["backoff_slots"] * t.slot_s
+    window_end = 1.0 + len(node.net.requesters["first"]) * step
+    b.t = 1.0
+    node._open_window("first")                      # a corrupt frame ended at 1.0 s
+    b.t = 1.0 + step / 2
+    assert node._backoff_wait("first") == 0.0        # inside its slot: go
+    for at in (1.0 + step - 1e-14, 1.0 + step - t.bit_s / 2):
+        b.t = at
+        assert node._backoff_wait("first") == pytest.approx(window_end - at)

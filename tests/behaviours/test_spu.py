@@ -6,6 +6,7 @@ from arachnae_proto.enums import RangeStatus, RecordKind, TpscContact
 from arachnae_proto.network import ADDRESS_OF as A
 
 from behaviours import tuning as T
+from behaviours.runtime import BusTiming
 from behaviours.units import quantizer
 from tests.behaviours.rig import Rig
 
@@ -173,3 +174,21 @@ def test_asked_for_its_id_again_after_reporting_the_spu_runs_a_new_post(spec):
     assert rig.node.debug_metrics()["posts"] == 2
     polls_after = [t for t, f in rig.frames(M.XmitData) if t > 7.0]
     assert polls_after                                      # polling resumed after the new POST
+
+
+def test_a_sensor_announcing_again_before_its_fetch_goes_out_is_fetched_once(spec):
+    """seed 3.2.2 / arbitration model: one request per slave. DATA_RDYs while the sonar's fetch still waits for the
+    line add none (the free-running USRC had piled up nine, every other sensor past K); an urgent fetch is not
+    folded into an ordinary poll of the same sensor still waiting (that one comes last)."""
+    rig, _ = spu(spec)
+    t = rig.board.t
+    for k in range(3):
+        rig.inject(t + 0.001 * k, A["USRC"], M.DataRdy())
+    rig.node.request(A["LSC"], M.XmitData(), (M.XmitDataLsc,))          # an ordinary poll, waiting
+    rig.inject(t + 0.003, A["LSC"], M.DataRdy())                        # an alarm: fetched as urgent
+    rig.run(t + 0.003)
+    assert rig.node.waiting(A["LSC"], M.XmitData, 1)
+    rig.run(t + 1.0)
+    assert len([1 for at, _f in rig.frames(M.XmitData, A["USRC"]) if at >= t]) == 1
+    assert rig.node.debug_metrics()["coalesced"] == 2
+
