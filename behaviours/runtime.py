@@ -102,7 +102,7 @@ class Request:
 class MasterLink:
     """A master's side of the bus it polls: one transaction at a time, in order."""
 
-    __slots__ = ("bus", "timing", "queue", "current", "serial", "frame", "waiters")
+    __slots__ = ("bus", "timing", "queue", "current", "serial", "frame")
 
     def __init__(self, bus: str) -> None:
         self.bus, self.timing = bus, BusTiming(bus)
@@ -110,7 +110,6 @@ class MasterLink:
         self.current: Request | None = None
         self.serial = 0
         self.frame = b""
-        self.waiters: deque[Callable[[], Any]] = deque()
 
 
 class Runtime:
@@ -192,20 +191,10 @@ class Runtime:
         return any(r.dst == dst and type(r.msg) is msg and r.priority >= priority
                    for r in ([cur] if cur is not None and not cur.sent else []) + list(link.queue))
 
-    def when_idle(self, fn: Callable[[], Any]) -> None:
-        """Run fn once every transaction queued so far on the mastered bus has finished."""
-        link = self.links[self.master_bus]  # type: ignore[index]
-        if link.current is None and not link.queue:
-            fn()
-        else:
-            link.waiters.append(fn)
-
     def _next(self, link: MasterLink) -> None:
         if link.current is not None:
             return
         if not link.queue:
-            while link.waiters and link.current is None and not link.queue:
-                link.waiters.popleft()()
             return
         link.serial += 1
         req = link.queue.popleft()

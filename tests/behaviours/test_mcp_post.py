@@ -93,3 +93,21 @@ def test_move_is_relayed_and_resent_until_the_mmc_status_confirms_it(spec):
     relayed = rig.frames(M.MoveRelayed)
     assert len(relayed) == 1 + spec.protocol.move_retries
     assert all(f.message.address == A["NP3"] and f.message.mov_cmd == Direction.FORWARD for _, f in relayed)
+
+
+def test_post_finishes_while_other_traffic_keeps_the_bus_busy(spec):
+    """seed 6.3: POST at any time. A master whose bus never falls idle (the MMC's gait traffic while walking)
+    still queries its sub-masters once its own ID_REQs and STATUS_REQs are done (post_rerun seed 2 ended
+    HALTED: the MMC's report waited for an idle leg bus for 5 s)."""
+    rig = Rig(spec, "MCP", MCP, first_bus())
+    node, link = rig.node, rig.node.links[rig.node.master_bus]
+
+    def chatter() -> None:                       # always one more transaction waiting behind the current one
+        if not link.queue:
+            node.request(A["MMC"], M.StatusReq(), (M.StatusAckMmc,))
+    node.every(0.002, chatter)
+    rig.run(1.0)
+    assert rig.node.verdict.verdict == "OPERATIONAL"
+    assert {f.dst for _, f in rig.frames(M.PostQuery)} == {A["MMC"], A["SPU"]}
+    queried = max(t for t, _ in rig.frames(M.PostQuery))
+    assert any(t > queried for t, _ in rig.frames(M.StatusReq, A["MMC"]))   # the bus stayed busy throughout
