@@ -49,6 +49,7 @@ class Result:
     store_bytes: int = 0                       # bytes of the stored graph (states, parents, edges)
     cpu: float = 0.0                           # CPU seconds of the whole check (search and properties)
     proof: bool = True                         # False after a bitstate search: a pass proves nothing
+    native: Native | None = None               # the compiled model the search ended on (None: Python)
 
     @property
     def ok(self) -> bool:
@@ -126,7 +127,7 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
     store = StateStore(comp.layout.total_bits, len(model.rules))
     store.add_initial(comp.init)
     res.layer_starts = [0, 1]
-    hit, hit_id = _search(model, comp, store, res.layer_starts, bar, res.times)
+    hit, hit_id, res.native = _search(model, comp, store, res.layer_starts, bar, res.times)
     res.store_bytes = store.nbytes         # before finish drops the hash table: the search's peak
     store.finish()
     res.store = store
@@ -156,8 +157,9 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
 
 
 def _search(model: Model, comp: Compiled, store: StateStore, layer_starts: list[int], bar: Progress | None,
-            times: dict[str, float]) -> tuple[tuple | None, int]:
-    """Breadth-first layers; (hit, id of the hit state) or (None, -1).
+            times: dict[str, float]) -> tuple[tuple | None, int, Native | None]:
+    """Breadth-first layers; (hit, id of the hit state, the compiled model used or None), hit None
+    and id -1 when there is none.
 
     Layers start on the generated Python `edges`; once the search has NATIVE_AFTER states it
     goes on with the compiled C successor function (model_check.native), if there is one: a
@@ -175,11 +177,11 @@ def _search(model: Model, comp: Compiled, store: StateStore, layer_starts: list[
         new, hit = (_layer_native(model, store, frontier, lo, nat) if nat is not None
                     else _layer_python(comp, store, frontier, lo))
         if hit is not None:
-            return hit
+            return (*hit, nat)
         lo += len(frontier)
         frontier = new
         _next_layer(store, layer_starts, bar, lo, len(frontier))
-    return None, -1
+    return None, -1, nat
 
 
 def _child_cpu() -> float:

@@ -122,6 +122,107 @@ static inline I pmod(I a, I b) { I r = a % b; return (r != 0 && ((r < 0) != (b <
 """
 
 
+def predicate_texts(model: Model) -> list[str]:
+    """The predicates the C code evaluates over stored states: `final`, then each response's
+    trigger and goal (index 1 + 2k and 2 + 2k)."""
+    return [model.final] + [t for r in model.responses for t in (r.trigger, r.goal)]
+
+
+# Response checks on the stored graph (model_check.liveness's algorithm in one pass, issue 12):
+# B = the states reachable from a trigger state (not a goal state) without passing a goal state.
+# An iterative Tarjan over B finds its strongly connected components in reverse topological
+# order, so when B is acyclic each state's longest tick path to the goal is known when its
+# component closes (the bound K); a cyclic component is checked for weak fairness (every group
+# enabled in all its states is taken inside it) there and then. Numbers only: no spec text.
+L_BOUND, L_FAIR_ONLY, L_VIOLATION, L_NOMEM, L_OVERFLOW = 0, 1, 2, 3, 4
+_GRAPH_COMMON = """\
+#include <stdlib.h>
+typedef struct { int64_t kind, bound; } LRes;
+typedef struct { int32_t node, k; } Frame;
+static int reserve(void **p, int64_t *cap, int64_t need, size_t size) {
+    if (need <= *cap) return 1;
+    int64_t c = *cap ? *cap : 4096;
+    while (c < need) c *= 2;
+    void *q = realloc(*p, (size_t)c * size);
+    if (!q) return 0;
+    *p = q; *cap = c; return 1;
+}
+#define PUSH(V) do { int32_t v_ = (V); \\
+    if (off[v_ + 1] == off[v_]) { r->kind = %d; goto out; } \\
+    if (!reserve((void **)&stk, &scap, sp + 1, sizeof *stk) || !reserve((void **)&fr, &fcap, cp + 1, sizeof *fr)) \\
+        { r->kind = %d; goto out; } \\
+    idx[v_] = low[v_] = counter++; stk[sp++] = v_; fr[cp].node = v_; fr[cp].k = 0; cp++; } while (0)
+""" % (L_VIOLATION, L_NOMEM)
+_GRAPH = """\
+void NAME(int64_t n, const OT *off, const int32_t *dst, const RT *rule, const uint8_t *goal, const uint8_t *trig,
+          const int32_t *ticks, const U *bit, int32_t *idx, int32_t *low, LRes *r) {
+    int32_t *stk = 0; Frame *fr = 0;
+    int64_t scap = 0, fcap = 0, sp = 0, cp = 0;
+    int32_t counter = 0;
+    int cyclic = 0;
+    r->kind = %(bound)d; r->bound = 0;
+    for (int64_t i = 0; i < n; i++) idx[i] = -1;
+    for (int64_t root = 0; root < n; root++) {
+        if (!trig[root] || goal[root] || idx[root] != -1) continue;
+        PUSH((int32_t)root);
+        while (cp > 0) {
+            Frame *f = &fr[cp - 1];
+            int32_t u = f->node;
+            OT e = (OT)(off[u] + f->k);
+            if (e < off[u + 1]) {
+                f->k++;
+                int32_t v = dst[e];
+                if (goal[v]) continue;
+                if (idx[v] == -1) PUSH(v);
+                else if (idx[v] >= 0 && idx[v] < low[u]) low[u] = idx[v];
+                continue;
+            }
+            cp--;
+            if (cp > 0 && low[u] < low[fr[cp - 1].node]) low[fr[cp - 1].node] = low[u];
+            if (low[u] != idx[u]) continue;
+            /* u roots a component: stk[base .. sp-1]; a successor outside it is closed (idx -2) */
+            int64_t base = sp - 1;
+            while (stk[base] != u) base--;
+            int self = 0;
+            U always = ~(U)0, taken = 0;
+            int64_t longest = 0;
+            for (int64_t q = base; q < sp; q++) {
+                int32_t w = stk[q];
+                U en = 0;
+                for (OT x = off[w]; x < off[w + 1]; x++) {
+                    int32_t v = dst[x];
+                    U b = bit[rule[x]];
+                    int64_t c = ticks[rule[x]];
+                    en |= b;
+                    if (goal[v]) { if (c > longest) longest = c; continue; }
+                    if (idx[v] >= idx[u]) { taken |= b; self |= v == w; }
+                    else if (c + low[v] > longest) longest = c + low[v];
+                }
+                always &= en;
+            }
+            if (sp - base == 1 && !self) {
+                if (longest > INT32_MAX) { r->kind = %(overflow)d; goto out; }
+                low[u] = (int32_t)longest;
+            } else {
+                cyclic = 1;
+                if ((always & ~taken) == 0) { r->kind = %(violation)d; goto out; }   /* a weakly fair cycle */
+                for (int64_t q = base; q < sp; q++) low[stk[q]] = 0;
+            }
+            for (int64_t q = base; q < sp; q++) idx[stk[q]] = -2;
+            sp = base;
+        }
+    }
+    if (cyclic) r->kind = %(fair)d;
+    else
+        for (int64_t i = 0; i < n; i++)
+            if (trig[i] && !goal[i] && low[i] > r->bound) r->bound = low[i];
+out:
+    free(stk);
+    free(fr);
+}
+""" % {"bound": L_BOUND, "overflow": L_OVERFLOW, "violation": L_VIOLATION, "fair": L_FAIR_ONLY}
+
+
 class _Src:
     """The C text of one model, from its variables' bit fields (compile.Layout)."""
 
@@ -137,7 +238,7 @@ class _Src:
 
     def source(self) -> str:
         m, W = self.model, self.words
-        out = [_PRELUDE, f"#define W {W}"]
+        out = [_PRELUDE, _GRAPH_COMMON, f"#define W {W}"]
         for n, text in m.defs:                  # definitions: pure functions of the state
             out.append(f"static inline I d_{n}(const U *s) {{ return {_c(expr.parse(text), self.name)}; }}")
         out += self.canon()
@@ -147,7 +248,30 @@ class _Src:
         out.append("    return -1;\n}")
         out.append(f"static inline int is_final(const U *s) {{ return ({_c(expr.parse(m.final), self.name)}) != 0; }}")
         out += self.search()
+        out += self.predicates()
+        out += [_GRAPH.replace("OT", o).replace("RT", r).replace("NAME", f"respond_{o}_{r}")
+                for o in ("int32_t", "int64_t") for r in ("uint8_t", "uint16_t")]
         return "\n".join(out) + "\n"
+
+    def predicates(self) -> list[str]:
+        """`pred(k, rows, ...)`: predicate k of `predicate_texts` over stored byte rows (storage)."""
+        texts = predicate_texts(self.model)
+        out = [f"static int p_{k}(const U *s) {{ return ({_c(expr.parse(t), self.name)}) != 0; }}"
+               for k, t in enumerate(texts)]
+        out.append("typedef int (*Pred)(const U *);")
+        out.append("static const Pred PREDS[] = {" + ", ".join(f"p_{k}" for k in range(len(texts))) + "};")
+        out.append("""\
+void pred(int64_t k, const uint8_t *rows, int64_t n, int64_t width, uint8_t *out) {
+    Pred p = PREDS[k];
+    U s[W];
+    for (int64_t i = 0; i < n; i++) {
+        const uint8_t *row = rows + (size_t)i * (size_t)width;
+        memset(s, 0, sizeof s);
+        for (int64_t j = 0; j < width; j++) s[j >> 3] |= (U)row[j] << (8 * (j & 7));   /* little-endian rows */
+        out[i] = (uint8_t)p(s);
+    }
+}""")
+        return out
 
     def canon(self) -> list[str]:
         """Sort each symmetry group's blocks ascending, in the group order (compile._canon_source)."""
@@ -232,6 +356,10 @@ typedef struct { int64_t done, edges, distinct, kind, index, rule, var, value; }
         return out
 
 
+class _LRes(ctypes.Structure):
+    _fields_ = [("kind", ctypes.c_int64), ("bound", ctypes.c_int64)]
+
+
 class _Res(ctypes.Structure):
     _fields_ = [(f, ctypes.c_int64) for f in ("done", "edges", "distinct", "kind", "index", "rule", "var", "value")]
 
@@ -266,7 +394,7 @@ class Native:
     """A compiled model: `expand(rows)` runs the C function over a slice of frontier rows."""
 
     def __init__(self, lib: ctypes.CDLL, words: int, rules: int):
-        self.words, self.n_rules = words, max(rules, 1)
+        self.lib, self.words, self.n_rules = lib, words, max(rules, 1)
         self.fn = lib.expand
         self.fn.restype = None
         self.cap = 0
@@ -298,6 +426,35 @@ class Native:
         return Chunk(int(r.done), self.out[:r.distinct].copy(), self.inv[:r.edges].copy(),
                      self.rules[:r.edges].copy(), ends[:r.done], int(r.kind), int(r.index),
                      int(r.rule), int(r.var), int(r.value))
+
+
+    def predicate(self, k: int, rows: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """Predicate k of `predicate_texts` in each stored byte row (storage.StateStore.keys), as bool."""
+        rows = np.ascontiguousarray(rows, np.uint8)
+        res = np.empty(len(rows), bool) if out is None else out
+        p = ctypes.c_void_p
+        self.lib.pred(ctypes.c_int64(k), p(rows.ctypes.data), ctypes.c_int64(len(rows)),
+                      ctypes.c_int64(rows.shape[1]), p(res.ctypes.data))
+        return res
+
+    def respond(self, offsets: np.ndarray, dst: np.ndarray, rule: np.ndarray, goal: np.ndarray,
+                trigger: np.ndarray, ticks: np.ndarray, bit: np.ndarray, work: np.ndarray) -> tuple[int, int]:
+        """One response on the stored CSR graph: (L_* kind, bound K when L_BOUND). `goal` and
+        `trigger` are bool per state, `ticks` int32 and `bit` uint64 per rule, `work` an int32
+        array of shape (2, states) the pass may overwrite."""
+        fn = getattr(self.lib, f"respond_{'int32_t' if offsets.dtype == np.int32 else 'int64_t'}_"
+                               f"{'uint8_t' if rule.dtype == np.uint8 else 'uint16_t'}")
+        fn.restype = None
+        for a, dtype in ((offsets, offsets.dtype), (dst, np.int32), (rule, rule.dtype), (goal, bool),
+                         (trigger, bool), (ticks, np.int32), (bit, np.uint64), (work, np.int32)):
+            if a.dtype != dtype or not a.flags.c_contiguous:
+                raise TypeError(f"respond: an array of {a.dtype}, not contiguous {np.dtype(dtype)}")
+        out = _LRes()
+        p = ctypes.c_void_p
+        fn(ctypes.c_int64(len(goal)), p(offsets.ctypes.data), p(dst.ctypes.data), p(rule.ctypes.data),
+           p(goal.ctypes.data), p(trigger.ctypes.data), p(ticks.ctypes.data), p(bit.ctypes.data),
+           p(work[0].ctypes.data), p(work[1].ctypes.data), ctypes.byref(out))
+        return int(out.kind), int(out.bound)
 
 
 def c_source(model: Model, shift: dict[str, int], width: dict[str, int], total_bits: int) -> str:

@@ -10,12 +10,12 @@ import random
 import numpy as np
 import pytest
 
-from model_check import engine, native
+from model_check import engine, liveness, native
 from model_check import spec_adapter as sa
 from model_check.compile import RangeError, compile_model
 from model_check.engine import explore
-from model_check.gcl import Model, Rule, SymGroup, Var
-from model_check.models import post
+from model_check.gcl import Model, Response, Rule, SymGroup, Var
+from model_check.models import arbitration, id_retry, post
 from model_check.storage import StateStore
 from tests.model_check import toys
 from tests.model_check.test_fastgen import MODELS, _reference_step, _same
@@ -110,3 +110,72 @@ def test_post_oracle_screen_equals_the_oracle(spec):
     bulk = post.oracle_screen(p, t, names, {k: np.array([v[k] for v in views]) for k in views[0]})
     assert bulk.tolist() == [post.oracle_mismatch(p, t, names, v) is not None for v in views]
     assert 0 < bulk.sum() < len(views)
+
+
+def _dead_end() -> Model:
+    """A trigger state whose run can end (a final state) before the goal: a liveness violation."""
+    vs = [Var("x", 3), Var("g", 1)]
+    rules = [Rule("go", "x < 2", (("x", "x + 1"),), actor="a", ticks=2),
+             Rule("hit", "x == 1", (("g", "1"), ("x", "3")), actor="a", ticks=5)]
+    return Model("dead_end", vs, rules, final="x >= 2", responses=[Response("goal", "x == 1", "g == 1")])
+
+
+def _random_responses(seed: int) -> Model:
+    """A random graph over small counters with many random responses: bounded ones, cycles fair
+    and unfair, dead ends -- every verdict of the response check occurs."""
+    rng = random.Random(seed)
+    hi = {"a": 5, "b": 5, "c": 1}
+    vs = [Var(n, h) for n, h in hi.items()]
+    rules = []
+    for k in range(12):
+        v, w = rng.choice(list(hi)), rng.choice(list(hi))
+        guard = f"{w} {rng.choice(('==', '!=', '<', '>'))} {rng.randint(0, hi[w])}"
+        effect = rng.choice((f"({v} + 1) % {hi[v] + 1}", str(rng.randint(0, hi[v])), f"{hi[v]} - {v}",
+                             f"({v} + {w}) % {hi[v] + 1}"))
+        rules.append(Rule(f"r{k}", guard, ((v, effect),), actor=rng.choice(("p", "q", None)),
+                          ticks=rng.randint(0, 3)))
+    cmp = ("==", "!=", "<", ">")
+    responses = [Response(f"resp{k}", f"{rng.choice('ab')} {rng.choice(cmp)} {rng.randint(0, 5)}",
+                          f"{rng.choice('ab')} {rng.choice(cmp)} {rng.randint(0, 5)}") for k in range(40)]
+    return Model(f"random{seed}", vs, rules, final="c == 1", responses=responses)
+
+
+def _idle_loop() -> Model:
+    """A self-loop of no fairness group after the trigger: a fair cycle of one state (its lasso
+    goes round the self-loop)."""
+    rules = [Rule("start", "a == 0", (("a", "1"),), actor="p", ticks=1), Rule("idle", "a == 1", (("a", "1"),))]
+    return Model("idle_loop", [Var("a", 2)], rules, responses=[Response("back", "a == 1", "a == 2")])
+
+
+RESPONDING = [("idle-loop", lambda s: _idle_loop()), ("countdown", lambda s: toys.countdown(4)), ("countdown-stutter", lambda s: toys.countdown(4, True)),
+              ("spin-forever", lambda s: toys.spin_forever()), ("dead-end", lambda s: _dead_end()),
+              ("arb-colliders-2", lambda s: arbitration.build(sa.arbitration(s, "sensor", "colliders"), "spec", 2)),
+              ("id-first-2", lambda s: id_retry.build(sa.identification(s, "first"), 2))] + [
+              (f"random-{k}", lambda s, k=k: _random_responses(k)) for k in (0, 3, 4)]
+
+
+@pytest.mark.parametrize("build", [b for _, b in RESPONDING], ids=[n for n, _ in RESPONDING])
+def test_native_responses_decide_as_the_numpy_algorithm(spec, build, monkeypatch):
+    """Per response, the C pass's verdict (bound K, fair-only, violation) is the numpy algorithm's,
+    and a whole check gives the same bounds and counterexample on either."""
+    model = build(spec)
+    ref = explore(model, compile_model(model, optimise=False), progress=False)
+    monkeypatch.setattr(engine, "NATIVE_AFTER", 0)
+    got = explore(model, progress=False)
+    assert got.native is not None and ref.native is None
+    assert got.bounds == ref.bounds
+    _same(got, ref)
+    kinds = set()
+    fast, graph = liveness._Native(ref), liveness._Graph(ref)
+    fast.nat = got.native
+    for index in range(len(model.responses)):
+        bound, violation = liveness.check_response(ref, index, graph)
+        kinds.add("violation" if violation else "fair-only" if bound is None else "bound")
+        fast.check(index)
+        kind, k = got.native.respond(ref.store.offsets, ref.store.dst.view, ref.store.rule.view, fast.goal,
+                                     fast.trigger, fast.ticks, fast.bit, fast.work)
+        assert (kind, k if kind == native.L_BOUND else None) == (
+            (native.L_VIOLATION, None) if violation else
+            (native.L_FAIR_ONLY, None) if bound is None else (native.L_BOUND, bound)), model.responses[index]
+    if model.name.startswith("random"):
+        assert kinds == {"violation", "fair-only", "bound"}, kinds
