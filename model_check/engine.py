@@ -114,8 +114,9 @@ class Progress:
 
 
 def explore(model: Model, compiled: Compiled | None = None, progress: bool = True,
-            check_liveness: bool = True) -> Result:
-    """Explore every reachable state; stop at the first safety violation."""
+            check_liveness: bool = True, use_native: bool | None = None) -> Result:
+    """Explore every reachable state; stop at the first safety violation. `use_native`: True
+    compiles the model for C at once, False never, None from NATIVE_AFTER states (see _search)."""
     comp = compiled or compile_model(model)
     res = Result(model=model, compiled=comp, coverage=[0] * len(model.rules))
     if model.symmetry and model.responses and check_liveness:
@@ -127,13 +128,13 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
     store = StateStore(comp.layout.total_bits, len(model.rules))
     store.add_initial(comp.init)
     res.layer_starts = [0, 1]
-    hit, hit_id, res.native = _search(model, comp, store, res.layer_starts, bar, res.times)
+    hit, hit_id, res.native = _search(model, comp, store, res.layer_starts, bar, res.times, use_native)
     res.store_bytes = store.nbytes         # before finish drops the hash table: the search's peak
     store.finish()
     res.store = store
     res.seconds = time.perf_counter() - t0
     # CPU seconds: comparable on a busy machine
-    res.times = {"search": time.process_time() - c0, **res.times}
+    res.times = {"search": time.process_time() - c0 - res.times.pop("compile, in process", 0.0), **res.times}
     res.coverage = store.coverage()
     res.states, res.transitions, res.depth = len(store), sum(res.coverage), len(res.layer_starts) - 2
     try:
@@ -157,36 +158,41 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
 
 
 def _search(model: Model, comp: Compiled, store: StateStore, layer_starts: list[int], bar: Progress | None,
-            times: dict[str, float]) -> tuple[tuple | None, int, Native | None]:
+            times: dict[str, float], use_native: bool | None) -> tuple[tuple | None, int, Native | None]:
     """Breadth-first layers; (hit, id of the hit state, the compiled model used or None), hit None
     and id -1 when there is none.
 
-    Layers start on the generated Python `edges`; once the search has NATIVE_AFTER states it
-    goes on with the compiled C successor function (model_check.native), if there is one: a
-    small model never pays for a compiler run, a big one gets C speed. Both give the same ids,
-    parents, edges and hits, so where the switch happens changes no result."""
-    frontier: list[int] | np.ndarray = [comp.init]
-    lo, nat, tried = 0, None, False
-    while len(frontier):
-        if nat is None and not tried and len(store) >= NATIVE_AFTER:
-            tried, before = True, _child_cpu()
+    The compiled C search (model_check.native) runs from the first state when its shared object
+    is in the cache or `use_native` is True, else once the search has NATIVE_AFTER states (a small
+    model never waits for a compiler run); before that, and without a compiler or with
+    `use_native` False, the generated Python `edges`. Both give the same ids, parents, edges and
+    hits, so where the switch happens changes no result. Generating and compiling the C is timed
+    apart ("compile", own and compiler CPU), not as search: SPIN's pan.c compile is not its search."""
+    frontier: list[int] = [comp.init]
+    lo, nat, tried = 0, None, use_native is False
+    while True:
+        if not tried and (use_native or len(store) >= NATIVE_AFTER or comp.native.cached()):  # type: ignore[attr-defined]
+            tried, before, own = True, _cpu(), time.process_time()
             nat = comp.native()
-            times["compile"] = _child_cpu() - before      # the C compiler's CPU (0 when it was cached)
-            if nat is not None:
-                frontier = store.to_words(frontier)
-        new, hit = (_layer_native(model, store, frontier, lo, nat) if nat is not None
-                    else _layer_python(comp, store, frontier, lo))
+            times["compile"] = _cpu() - before
+            times["compile, in process"] = time.process_time() - own     # explore takes it off the search
+        hi = len(store)
+        if nat is not None:           # breadth-first order is id order: the layer is ids lo .. hi-1
+            hit = _layer_native(store, lo, hi, nat, model)
+        else:
+            frontier, hit = _layer_python(comp, store, frontier, lo)
         if hit is not None:
             return (*hit, nat)
-        lo += len(frontier)
-        frontier = new
-        _next_layer(store, layer_starts, bar, lo, len(frontier))
-    return None, -1, nat
+        lo = hi
+        if len(store) == hi:
+            return None, -1, nat
+        _next_layer(store, layer_starts, bar, lo, len(store) - hi)
 
 
-def _child_cpu() -> float:
+def _cpu() -> float:
+    """CPU seconds of this process and its finished children (the C compiler)."""
     t = os.times()
-    return t.children_user + t.children_system
+    return t.user + t.system + t.children_user + t.children_system
 
 
 def _layer_python(comp: Compiled, store: StateStore, frontier: list[int], lo: int):
@@ -206,21 +212,18 @@ def _layer_python(comp: Compiled, store: StateStore, frontier: list[int], lo: in
     return new, None
 
 
-def _layer_native(model: Model, store: StateStore, frontier: np.ndarray, lo: int, nat: Native):
-    """One layer with the C successor function, a call at a time (a call stops when its buffers
-    are full): (next frontier rows, None) or (_, (hit, hit id))."""
-    new: list[np.ndarray] = []
-    a = 0
-    while a < len(frontier):
-        chunk = nat.expand(frontier[a:a + SLICE])
-        fresh = store.add_edges(lo + a, chunk.distinct, chunk.inv, chunk.rules, chunk.ends)
-        new.append(chunk.distinct[fresh])
-        a += chunk.done
-        if chunk.kind == HIT_RANGE:
-            raise RangeError(chunk.range_message(model))
-        if chunk.hit() is not None:
-            return new, (chunk.hit(), lo + a)
-    return (np.concatenate(new) if new else frontier[:0]), None
+def _layer_native(store: StateStore, lo: int, hi: int, nat: Native, model: Model):
+    """The states lo .. hi-1 with the compiled search, straight into the store, a call at a time
+    (a call stops when the arrays are full): None, or (hit, hit id)."""
+    i = lo
+    while i < hi:
+        got = nat.bfs(store, i, hi, model)
+        i = got.done
+        if got.kind == HIT_RANGE:
+            raise RangeError(got.message)
+        if got.hit() is not None:
+            return got.hit(), i
+    return None
 
 
 def _next_layer(store: StateStore, layer_starts: list[int], bar: Progress | None, lo: int, width: int) -> None:

@@ -33,14 +33,17 @@ import hashlib
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
 from model_check import expr
 from model_check.gcl import Model
+from model_check.storage import LOAD, StateStore
 
 CC_FLAGS = ("-O1", "-shared", "-fPIC", "-std=c99", "-w")
 HIT_NONE, HIT_INVARIANT, HIT_DEADLOCK, HIT_RANGE, HIT_FULL = 0, 1, 2, 3, 4
@@ -313,46 +316,103 @@ void pred(int64_t k, const uint8_t *rows, int64_t n, int64_t width, uint8_t *out
             out.append(f"            setb(t, {self.shift[target]}u, {self.width[target]}u, (U){local});")
         if m.symmetry:
             out.append("            canon(t);")
-        out.append(f"            EDGE({ri});")
+        out.append(f"            EMIT({ri});")
         out.append("        }")
         return out
 
     def search(self) -> list[str]:
         n_rules = len(self.model.rules)
-        out = ["""\
-typedef struct { int64_t done, edges, distinct, kind, index, rule, var, value; } Res;
-#define EDGE(RI) do { \\
-    U hh = 0x9E3779B97F4A7C15ULL; \\
-    for (int q = 0; q < W; q++) { hh ^= t[q]; hh *= 0xBF58476D1CE4E5B9ULL; hh ^= hh >> 31; } \\
-    U slot = hh & tmask; \\
-    int32_t got; \\
-    for (U step = 1;; step++) { \\
-        got = table[slot]; \\
-        if (got < 0) { got = (int32_t)nd; table[slot] = got; memcpy(out + (size_t)nd * W, t, sizeof t); nd++; break; } \\
-        if (memcmp(out + (size_t)got * W, t, sizeof t) == 0) break; \\
-        slot = (slot + step) & tmask; \\
-    } \\
-    inv[ne] = got; rules[ne] = (RI); ne++; \\
-} while (0)
-""",
-               "void expand(const U *front, int64_t n, U *out, int32_t *inv, int32_t *rules, int64_t *ends,",
-               "            int64_t cap, int32_t *table, int64_t tsize, Res *r) {",
-               "    U tmask = (U)tsize - 1; int64_t ne = 0, nd = 0, i = 0; U t[W];",
-               "    r->kind = 0;",
-               "    for (; i < n; i++) {",
-               f"        if (ne + {max(n_rules, 1)} > cap) {{ r->kind = {HIT_FULL}; break; }}",
-               "        const U *s = front + (size_t)i * W;",
-               "        int bad = inv_fail(s);",
-               f"        if (bad >= 0) {{ r->kind = {HIT_INVARIANT}; r->index = bad; break; }}",
-               "        int en = 0;"]
+        R = max(n_rules, 1)
+        rule_t = "uint8_t" if n_rules <= 256 else "uint16_t"      # storage.StateStore's rule array
+        out = ["typedef struct { int64_t done, edges, distinct, kind, index, rule, var, value; } Res;",
+               "#define EMIT(RI) do { memcpy(succ + (size_t)k * W, t, sizeof t); sr[k++] = (RI); } while (0)",
+               "/* the successors of s in rule order (canonical), their rules; -1 on a range hit (r says it) */",
+               "static int64_t gen(const U *s, U *succ, int32_t *sr, Res *r) {",
+               "    int64_t k = 0; U t[W]; int en = 0;"]
         for ri in range(n_rules):
             out += self.rule(ri)
-        out += [f"        if (!en && !is_final(s)) {{ r->kind = {HIT_DEADLOCK}; break; }}",
-                "        ends[i] = ne;",
-                "    }",
-                "stop:",
-                "    r->done = i; r->edges = ne; r->distinct = nd;",
-                "}"]
+        out += ["    (void)en;", "    return k;", "stop:", "    return -1;", "}"]
+        out.append(f"""\
+#define NRULES {R}
+/* one state's check before its successors: 0 to go on, else the hit is in r */
+static inline int64_t visit(const U *s, U *succ, int32_t *sr, Res *r) {{
+    int bad = inv_fail(s);
+    if (bad >= 0) {{ r->kind = {HIT_INVARIANT}; r->index = bad; return -1; }}
+    int64_t k = gen(s, succ, sr, r);
+    if (k == 0 && !is_final(s)) {{ r->kind = {HIT_DEADLOCK}; return -1; }}
+    return k;
+}}
+/* expand: frontier rows, successors deduplicated within the call (model_check.parallel, bitstate) */
+void expand(const U *front, int64_t n, U *out, int32_t *inv, int32_t *rules, int64_t *ends,
+            int64_t cap, int32_t *table, int64_t tsize, Res *r) {{
+    U tmask = (U)tsize - 1; int64_t ne = 0, nd = 0, i = 0;
+    U succ[NRULES * W]; int32_t sr[NRULES];
+    r->kind = 0;
+    for (; i < n; i++) {{
+        if (ne + NRULES > cap) {{ r->kind = {HIT_FULL}; break; }}
+        int64_t k = visit(front + (size_t)i * W, succ, sr, r);
+        if (k < 0) break;
+        for (int64_t j = 0; j < k; j++) {{
+            const U *t = succ + (size_t)j * W;
+            U hh = 0x9E3779B97F4A7C15ULL;
+            for (int q = 0; q < W; q++) {{ hh ^= t[q]; hh *= 0xBF58476D1CE4E5B9ULL; hh ^= hh >> 31; }}
+            U slot = hh & tmask;
+            int32_t got;
+            for (U step = 1;; step++) {{
+                got = table[slot];
+                if (got < 0) {{ got = (int32_t)nd; table[slot] = got; memcpy(out + (size_t)nd * W, t, W * sizeof(U)); nd++; break; }}
+                if (memcmp(out + (size_t)got * W, t, W * sizeof(U)) == 0) break;
+                slot = (slot + step) & tmask;
+            }}
+            inv[ne] = got; rules[ne] = sr[j]; ne++;
+        }}
+        ends[i] = ne;
+    }}
+    r->done = i; r->edges = ne; r->distinct = nd;
+}}
+/* bfs: expand the stored states i .. stop-1 (ids in breadth-first order) into the store itself
+   (storage.StateStore): its hash table (mix64, triangular probing: the same slots as numpy's),
+   byte rows, parents, edges and degrees. Stops before a state whose successors might not fit
+   (keys up to klimit, edges up to ecap): the caller grows the arrays and calls again. */
+void bfs(int64_t i, int64_t stop, uint8_t *keys, int64_t nk, int64_t klimit, int64_t width,
+         int32_t *parent, int32_t *table, int64_t tbits, int32_t *dst, {rule_t} *rules, int64_t ne,
+         int64_t ecap, uint16_t *degree, Res *r) {{
+    U tmask = ((U)1 << tbits) - 1, s[W];
+    U succ[NRULES * W]; int32_t sr[NRULES];
+    uint8_t tb[W * 8];
+    r->kind = 0;
+    for (; i < stop; i++) {{
+        if (nk + NRULES > klimit || ne + NRULES > ecap) {{ r->kind = {HIT_FULL}; break; }}
+        const uint8_t *row = keys + (size_t)i * (size_t)width;
+        memset(s, 0, sizeof s);
+        for (int64_t j = 0; j < width; j++) s[j >> 3] |= (U)row[j] << (8 * (j & 7));
+        int64_t k = visit(s, succ, sr, r);
+        if (k < 0) break;
+        for (int64_t j = 0; j < k; j++) {{
+            const U *t = succ + (size_t)j * W;
+            U hh = t[0] * 0x9E3779B97F4A7C15ULL;
+            for (int q = 1; q < W; q++) hh = (hh ^ (hh >> 31) ^ t[q]) * 0xBF58476D1CE4E5B9ULL;
+            hh = (hh ^ (hh >> 29)) * 0x94D049BB133111EBULL;
+            U slot = hh >> (64 - tbits);
+            for (int64_t b = 0; b < width; b++) tb[b] = (uint8_t)(t[b >> 3] >> (8 * (b & 7)));
+            int32_t got;
+            for (U step = 1;; step++) {{
+                got = table[slot];
+                if (got < 0) {{
+                    got = (int32_t)nk; table[slot] = got;
+                    memcpy(keys + (size_t)nk * (size_t)width, tb, (size_t)width);
+                    parent[nk] = (int32_t)i; nk++;
+                    break;
+                }}
+                if (memcmp(keys + (size_t)got * (size_t)width, tb, (size_t)width) == 0) break;
+                slot = (slot + step) & tmask;
+            }}
+            dst[ne] = got; rules[ne] = ({rule_t})sr[j]; ne++;
+        }}
+        degree[i] = (uint16_t)k;
+    }}
+    r->done = i; r->edges = ne; r->distinct = nk;
+}}""")
         return out
 
 
@@ -380,14 +440,34 @@ class Chunk:
     value: int = 0
 
     def hit(self, state: int | None = None) -> tuple | None:
-        """The violation as the Python `edges` reports it: (kind, index, state), or None."""
-        if self.kind == HIT_INVARIANT:
-            return ("invariant", self.index, state)
-        return ("deadlock", -1, state) if self.kind == HIT_DEADLOCK else None
+        return _hit(self.kind, self.index, state)
 
     def range_message(self, model: Model) -> str:
-        """HIT_RANGE: the RangeError's text, as the Python `edges` words it."""
-        return f"{model.rules[self.rule].name}: {model.vars[self.var].name} = {self.value}"
+        return range_message(model, self.rule, self.var, self.value)
+
+
+def _hit(kind: int, index: int, state: int | None) -> tuple | None:
+    """The violation as the Python `edges` reports it: (kind, index, state), or None."""
+    if kind == HIT_INVARIANT:
+        return ("invariant", index, state)
+    return ("deadlock", -1, state) if kind == HIT_DEADLOCK else None
+
+
+def range_message(model: Model, rule: int, var: int, value: int) -> str:
+    """HIT_RANGE: the RangeError's text, as the Python `edges` words it."""
+    return f"{model.rules[rule].name}: {model.vars[var].name} = {value}"
+
+
+class Stop(NamedTuple):
+    """Why and where `Native.bfs` stopped."""
+
+    done: int                    # the first state not expanded
+    kind: int                    # HIT_* (HIT_FULL: arrays full, grow them and call again)
+    index: int                   # invariant index (HIT_INVARIANT)
+    message: str                 # HIT_RANGE: the RangeError's text
+
+    def hit(self) -> tuple | None:
+        return _hit(self.kind, self.index, None)
 
 
 class Native:
@@ -428,6 +508,31 @@ class Native:
                      int(r.rule), int(r.var), int(r.value))
 
 
+    def bfs(self, store: StateStore, i: int, stop: int, model: Model) -> Stop:
+        """Expand the stored states i .. stop-1 into `store` (new states, parents, edges, degrees)
+        until done, a hit, or full arrays (then `Stop.done` < stop: call again; the arrays grow
+        by a quarter before each call that needs it)."""
+        fn = self.lib.bfs
+        fn.restype = None
+        room = self.n_rules
+        store.reserve(room, room, stop)
+        keys, parent, dst, rule, degree = store.keys, store.parent, store.dst, store.rule, store.degree
+        if degree.n != i:
+            raise ValueError(f"bfs: state {i} expanded out of order ({degree.n} expanded)")
+        klimit = min(len(keys.data), len(parent.data), int(LOAD * len(store.table)))
+        ecap = min(len(dst.data), len(rule.data))
+        p, n64 = ctypes.c_void_p, ctypes.c_int64
+        fn(n64(i), n64(stop), p(keys.data.ctypes.data), n64(keys.n), n64(klimit), n64(store.width),
+           p(parent.data.ctypes.data), p(store.table.ctypes.data), n64(store.table_bits),
+           p(dst.data.ctypes.data), p(rule.data.ctypes.data), n64(dst.n), n64(ecap), p(degree.data.ctypes.data),
+           ctypes.byref(self.res))
+        r = self.res
+        keys.n = parent.n = int(r.distinct)
+        dst.n = rule.n = int(r.edges)
+        degree.n = int(r.done)
+        message = range_message(model, int(r.rule), int(r.var), int(r.value)) if r.kind == HIT_RANGE else ""
+        return Stop(int(r.done), int(r.kind), int(r.index), message)
+
     def predicate(self, k: int, rows: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Predicate k of `predicate_texts` in each stored byte row (storage.StateStore.keys), as bool."""
         rows = np.ascontiguousarray(rows, np.uint8)
@@ -464,31 +569,56 @@ def c_source(model: Model, shift: dict[str, int], width: dict[str, int], total_b
     return _Src(model, shift, width, total_bits).source()
 
 
-def build(model: Model, shift: dict[str, int], width: dict[str, int], total_bits: int) -> Native | None:
-    """The compiled successor function, or None (no compiler, an untranslated construct, or
-    ARACHNAE_NATIVE=0 in the environment): the caller then uses the Python one."""
-    if os.environ.get("ARACHNAE_NATIVE", "1") == "0":
-        return None
-    cc = shutil.which(os.environ.get("CC", "cc"))
-    if cc is None:
-        return None
-    try:
-        src = c_source(model, shift, width, total_bits)
-    except Unsupported:
-        return None
-    digest = hashlib.sha256((src + " ".join(CC_FLAGS)).encode()).hexdigest()[:24]
-    cache = _cache_dir()
-    lib = cache / f"succ_{digest}.so"
-    if not lib.exists():
-        try:
-            cache.mkdir(parents=True, exist_ok=True)
-            with tempfile.TemporaryDirectory(dir=cache) as tmp:
-                c_file, so = Path(tmp) / "succ.c", Path(tmp) / "succ.so"
-                c_file.write_text(src)
-                subprocess.run([cc, *CC_FLAGS, "-o", str(so), str(c_file)], check=True,
-                               capture_output=True, timeout=300)
-                os.replace(so, lib)             # atomic: a concurrent run sees all of it or nothing
-        except (OSError, subprocess.SubprocessError):
+class Builder:
+    """The compiled model of one Compiled, made on the first call and kept (None where there is
+    no compiler, an untranslated construct, or ARACHNAE_NATIVE=0 in the environment: the caller
+    then uses the Python successor function). `cached()` says whether a call costs no compiler
+    run, so a search can use C from its first state."""
+
+    def __init__(self, model: Model, shift: dict[str, int], width: dict[str, int], total_bits: int):
+        self.model, self.shift, self.width, self.total_bits = model, shift, width, total_bits
+        self.done, self.native = False, None
+        self._lib: Path | None | bool = False          # False: not worked out yet
+
+    def lib(self) -> Path | None:
+        """Where the shared object of this model is (or goes), None if there is none to be had."""
+        if self._lib is False:
+            self._lib = None
+            if os.environ.get("ARACHNAE_NATIVE", "1") != "0" and sys.byteorder == "little":
+                try:
+                    self.src = c_source(self.model, self.shift, self.width, self.total_bits)
+                    digest = hashlib.sha256((self.src + " ".join(CC_FLAGS)).encode()).hexdigest()[:24]
+                    self._lib = _cache_dir() / f"succ_{digest}.so"
+                except Unsupported:
+                    pass
+        return self._lib      # type: ignore[return-value]
+
+    def cached(self) -> bool:
+        lib = self.lib()
+        return self.done or (lib is not None and lib.exists())
+
+    def __call__(self) -> Native | None:
+        if not self.done:
+            self.done, self.native = True, self._build()
+        return self.native
+
+    def _build(self) -> Native | None:
+        lib = self.lib()
+        if lib is None:
             return None
-    words = max(1, -(-total_bits // 64))
-    return Native(ctypes.CDLL(str(lib)), words, len(model.rules))
+        if not lib.exists():
+            cc = shutil.which(os.environ.get("CC", "cc"))
+            if cc is None:
+                return None
+            try:
+                lib.parent.mkdir(parents=True, exist_ok=True)
+                with tempfile.TemporaryDirectory(dir=lib.parent) as tmp:
+                    c_file, so = Path(tmp) / "succ.c", Path(tmp) / "succ.so"
+                    c_file.write_text(self.src)
+                    subprocess.run([cc, *CC_FLAGS, "-o", str(so), str(c_file)], check=True,
+                                   capture_output=True, timeout=300)
+                    os.replace(so, lib)             # atomic: a concurrent run sees all of it or nothing
+            except (OSError, subprocess.SubprocessError):
+                return None
+        words = max(1, -(-self.total_bits // 64))
+        return Native(ctypes.CDLL(str(lib)), words, len(self.model.rules))

@@ -10,7 +10,7 @@ import random
 import numpy as np
 import pytest
 
-from model_check import engine, liveness, native
+from model_check import engine, liveness, native, storage
 from model_check import spec_adapter as sa
 from model_check.compile import RangeError, compile_model
 from model_check.engine import explore
@@ -64,14 +64,26 @@ def test_native_successors_of_random_states_equal_reference(spec, build):
 @pytest.mark.parametrize("after", [0, 5])
 @pytest.mark.parametrize("build", [b for _, b in SMALL], ids=[n for n, _ in SMALL])
 def test_native_search_equals_reference(spec, build, after, monkeypatch):
-    """From the first state (0) or mid-search (5), with calls stopped by tiny buffers."""
+    """From the first state (0) or mid-search (5), with calls stopped by full arrays after
+    (nearly) every state: the store's arrays grow by exactly what a call asks for."""
     model = build(spec)
     ref = explore(model, compile_model(model, optimise=False), progress=False)
     monkeypatch.setattr(engine, "NATIVE_AFTER", after)
     monkeypatch.setattr(native, "MAX_EDGES", 7)
+
+    def tight(self, extra):
+        if self.n + extra > len(self.data):
+            self.data.resize((self.n + extra, self.width) if self.width else self.n + extra, refcheck=False)
+    monkeypatch.setattr(storage.Grow, "reserve", tight)
+    calls = []
+    bfs = native.Native.bfs
+    monkeypatch.setattr(native.Native, "bfs", lambda self, *a: calls.append(a[1]) or bfs(self, *a))
     comp = compile_model(model)
+    monkeypatch.setattr(comp.native, "cached", lambda: False)     # so the switch is at `after` states
     got = explore(model, comp, progress=False)
     assert comp.native() is not None and "compile" in got.times
+    assert (bool(calls) and min(calls) == 0) == (after == 0)     # from the start, or after Python
+    assert after or not got.ok or len(calls) > got.depth          # stopped by full arrays within layers
     _same(got, ref)
     assert got.store.parent.view.tolist() == ref.store.parent.view.tolist()
     assert got.store.dst.view.tolist() == ref.store.dst.view.tolist()
