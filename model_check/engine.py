@@ -171,11 +171,13 @@ def _search(model: Model, comp: Compiled, store: StateStore, layer_starts: list[
     frontier: list[int] = [comp.init]
     lo, nat, tried = 0, None, use_native is False
     while True:
-        if not tried and (use_native or len(store) >= NATIVE_AFTER or comp.native.cached()):  # type: ignore[attr-defined]
-            tried, before, own = True, _cpu(), time.process_time()
-            nat = comp.native()
-            times["compile"] = _cpu() - before
-            times["compile, in process"] = time.process_time() - own     # explore takes it off the search
+        if not tried:
+            before, own = _cpu(), time.process_time()
+            if use_native or len(store) >= NATIVE_AFTER or comp.native.cached():  # type: ignore[attr-defined]
+                tried, nat = True, comp.native()
+            times["compile"] = times.get("compile", 0.0) + _cpu() - before
+            # explore takes this off the search
+            times["compile, in process"] = times.get("compile, in process", 0.0) + time.process_time() - own
         hi = len(store)
         if nat is not None:           # breadth-first order is id order: the layer is ids lo .. hi-1
             hit = _layer_native(store, lo, hi, nat, model)

@@ -142,6 +142,8 @@ _GRAPH_COMMON = """\
 #include <stdlib.h>
 typedef struct { int64_t kind, bound; } LRes;
 typedef struct { int32_t node, k; } Frame;
+#define GOAL(V) ((mask[V] >> gb) & 1u)
+#define TRIG(V) ((mask[V] >> tb) & 1u)
 static int reserve(void **p, int64_t *cap, int64_t need, size_t size) {
     if (need <= *cap) return 1;
     int64_t c = *cap ? *cap : 4096;
@@ -157,7 +159,7 @@ static int reserve(void **p, int64_t *cap, int64_t need, size_t size) {
     idx[v_] = low[v_] = counter++; stk[sp++] = v_; fr[cp].node = v_; fr[cp].k = 0; cp++; } while (0)
 """ % (L_VIOLATION, L_NOMEM)
 _GRAPH = """\
-void NAME(int64_t n, const OT *off, const int32_t *dst, const RT *rule, const uint8_t *goal, const uint8_t *trig,
+void NAME(int64_t n, const OT *off, const int32_t *dst, const RT *rule, const uint32_t *mask, int64_t tb, int64_t gb,
           const int32_t *ticks, const U *bit, int32_t *idx, int32_t *low, LRes *r) {
     int32_t *stk = 0; Frame *fr = 0;
     int64_t scap = 0, fcap = 0, sp = 0, cp = 0;
@@ -166,7 +168,7 @@ void NAME(int64_t n, const OT *off, const int32_t *dst, const RT *rule, const ui
     r->kind = %(bound)d; r->bound = 0;
     for (int64_t i = 0; i < n; i++) idx[i] = -1;
     for (int64_t root = 0; root < n; root++) {
-        if (!trig[root] || goal[root] || idx[root] != -1) continue;
+        if (!TRIG(root) || GOAL(root) || idx[root] != -1) continue;
         PUSH((int32_t)root);
         while (cp > 0) {
             Frame *f = &fr[cp - 1];
@@ -175,7 +177,7 @@ void NAME(int64_t n, const OT *off, const int32_t *dst, const RT *rule, const ui
             if (e < off[u + 1]) {
                 f->k++;
                 int32_t v = dst[e];
-                if (goal[v]) continue;
+                if (GOAL(v)) continue;
                 if (idx[v] == -1) PUSH(v);
                 else if (idx[v] >= 0 && idx[v] < low[u]) low[u] = idx[v];
                 continue;
@@ -197,7 +199,7 @@ void NAME(int64_t n, const OT *off, const int32_t *dst, const RT *rule, const ui
                     U b = bit[rule[x]];
                     int64_t c = ticks[rule[x]];
                     en |= b;
-                    if (goal[v]) { if (c > longest) longest = c; continue; }
+                    if (GOAL(v)) { if (c > longest) longest = c; continue; }
                     if (idx[v] >= idx[u]) { taken |= b; self |= v == w; }
                     else if (c + low[v] > longest) longest = c + low[v];
                 }
@@ -218,7 +220,7 @@ void NAME(int64_t n, const OT *off, const int32_t *dst, const RT *rule, const ui
     if (cyclic) r->kind = %(fair)d;
     else
         for (int64_t i = 0; i < n; i++)
-            if (trig[i] && !goal[i] && low[i] > r->bound) r->bound = low[i];
+            if (TRIG(i) && !GOAL(i) && low[i] > r->bound) r->bound = low[i];
 out:
     free(stk);
     free(fr);
@@ -264,14 +266,16 @@ class _Src:
         out.append("typedef int (*Pred)(const U *);")
         out.append("static const Pred PREDS[] = {" + ", ".join(f"p_{k}" for k in range(len(texts))) + "};")
         out.append("""\
-void pred(int64_t k, const uint8_t *rows, int64_t n, int64_t width, uint8_t *out) {
-    Pred p = PREDS[k];
+/* predicates k0 .. k1-1 (at most 32) in each stored row: bit k - k0 of out[i] */
+void preds(int64_t k0, int64_t k1, const uint8_t *rows, int64_t n, int64_t width, uint32_t *out) {
     U s[W];
     for (int64_t i = 0; i < n; i++) {
         const uint8_t *row = rows + (size_t)i * (size_t)width;
         memset(s, 0, sizeof s);
         for (int64_t j = 0; j < width; j++) s[j >> 3] |= (U)row[j] << (8 * (j & 7));   /* little-endian rows */
-        out[i] = (uint8_t)p(s);
+        uint32_t m = 0;
+        for (int64_t k = k0; k < k1; k++) m |= (uint32_t)PREDS[k](s) << (k - k0);
+        out[i] = m;
     }
 }""")
         return out
@@ -533,32 +537,34 @@ class Native:
         message = range_message(model, int(r.rule), int(r.var), int(r.value)) if r.kind == HIT_RANGE else ""
         return Stop(int(r.done), int(r.kind), int(r.index), message)
 
-    def predicate(self, k: int, rows: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
-        """Predicate k of `predicate_texts` in each stored byte row (storage.StateStore.keys), as bool."""
+    def predicates(self, k0: int, k1: int, rows: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """Predicates k0 .. k1-1 of `predicate_texts` (at most 32) in each stored byte row
+        (storage.StateStore.keys): bit k - k0 of a uint32 per row."""
+        if not 0 <= k0 <= k1 <= k0 + 32:
+            raise ValueError(f"predicates {k0} .. {k1 - 1}: at most 32 at a time")
         rows = np.ascontiguousarray(rows, np.uint8)
-        res = np.empty(len(rows), bool) if out is None else out
-        p = ctypes.c_void_p
-        self.lib.pred(ctypes.c_int64(k), p(rows.ctypes.data), ctypes.c_int64(len(rows)),
-                      ctypes.c_int64(rows.shape[1]), p(res.ctypes.data))
+        res = np.empty(len(rows), np.uint32) if out is None else out
+        p, n64 = ctypes.c_void_p, ctypes.c_int64
+        self.lib.preds(n64(k0), n64(k1), p(rows.ctypes.data), n64(len(rows)), n64(rows.shape[1]), p(res.ctypes.data))
         return res
 
-    def respond(self, offsets: np.ndarray, dst: np.ndarray, rule: np.ndarray, goal: np.ndarray,
-                trigger: np.ndarray, ticks: np.ndarray, bit: np.ndarray, work: np.ndarray) -> tuple[int, int]:
-        """One response on the stored CSR graph: (L_* kind, bound K when L_BOUND). `goal` and
-        `trigger` are bool per state, `ticks` int32 and `bit` uint64 per rule, `work` an int32
-        array of shape (2, states) the pass may overwrite."""
+    def respond(self, offsets: np.ndarray, dst: np.ndarray, rule: np.ndarray, mask: np.ndarray, trigger: int,
+                goal: int, ticks: np.ndarray, bit: np.ndarray, work: np.ndarray) -> tuple[int, int]:
+        """One response on the stored CSR graph: (L_* kind, bound K when L_BOUND). Its trigger
+        and goal are bits `trigger` and `goal` of `mask` (uint32 per state, see `predicates`);
+        `ticks` int32 and `bit` uint64 per rule; `work` int32 of shape (2, states), overwritten."""
         fn = getattr(self.lib, f"respond_{'int32_t' if offsets.dtype == np.int32 else 'int64_t'}_"
                                f"{'uint8_t' if rule.dtype == np.uint8 else 'uint16_t'}")
         fn.restype = None
-        for a, dtype in ((offsets, offsets.dtype), (dst, np.int32), (rule, rule.dtype), (goal, bool),
-                         (trigger, bool), (ticks, np.int32), (bit, np.uint64), (work, np.int32)):
+        for a, dtype in ((offsets, offsets.dtype), (dst, np.int32), (rule, rule.dtype), (mask, np.uint32),
+                         (ticks, np.int32), (bit, np.uint64), (work, np.int32)):
             if a.dtype != dtype or not a.flags.c_contiguous:
                 raise TypeError(f"respond: an array of {a.dtype}, not contiguous {np.dtype(dtype)}")
         out = _LRes()
-        p = ctypes.c_void_p
-        fn(ctypes.c_int64(len(goal)), p(offsets.ctypes.data), p(dst.ctypes.data), p(rule.ctypes.data),
-           p(goal.ctypes.data), p(trigger.ctypes.data), p(ticks.ctypes.data), p(bit.ctypes.data),
-           p(work[0].ctypes.data), p(work[1].ctypes.data), ctypes.byref(out))
+        p, n64 = ctypes.c_void_p, ctypes.c_int64
+        fn(n64(len(mask)), p(offsets.ctypes.data), p(dst.ctypes.data), p(rule.ctypes.data), p(mask.ctypes.data),
+           n64(trigger), n64(goal), p(ticks.ctypes.data), p(bit.ctypes.data), p(work[0].ctypes.data),
+           p(work[1].ctypes.data), ctypes.byref(out))
         return int(out.kind), int(out.bound)
 
 
