@@ -178,17 +178,36 @@ def _search(model: Model, comp: Compiled, store: StateStore, layer_starts: list[
             times["compile"] = times.get("compile", 0.0) + _cpu() - before
             # explore takes this off the search
             times["compile, in process"] = times.get("compile, in process", 0.0) + time.process_time() - own
+        if nat is not None:           # breadth-first order is id order: the layer is ids lo .. len-1
+            return (*_search_native(model, store, lo, nat, layer_starts, bar), nat)
         hi = len(store)
-        if nat is not None:           # breadth-first order is id order: the layer is ids lo .. hi-1
-            hit = _layer_native(store, lo, hi, nat, model)
-        else:
-            frontier, hit = _layer_python(comp, store, frontier, lo)
+        frontier, hit = _layer_python(comp, store, frontier, lo)
         if hit is not None:
             return (*hit, nat)
         lo = hi
         if len(store) == hi:
             return None, -1, nat
         _next_layer(store, layer_starts, bar, lo, len(store) - hi)
+
+
+def _search_native(model: Model, store: StateStore, lo: int, nat: Native, layer_starts: list[int],
+                   bar: Progress | None) -> tuple[tuple | None, int]:
+    """The rest of the search from the layer of ids lo .. len(store)-1 with the compiled search,
+    straight into the store, a call at a time (a call goes on over layers and stops when the
+    arrays are full): (hit, hit id) or (None, -1)."""
+    i, stop = lo, len(store)
+    while True:
+        got = nat.bfs(store, i, stop, model)
+        i = got.done
+        for end in got.layers:           # the layers this call began (the ones before ended in it)
+            _next_layer(store, layer_starts, bar, stop, end - stop)
+            stop = end
+        if got.kind == HIT_RANGE:
+            raise RangeError(got.message)
+        if got.hit() is not None:
+            return got.hit(), i
+        if i == stop == len(store):
+            return None, -1
 
 
 def _cpu() -> float:
@@ -212,20 +231,6 @@ def _layer_python(comp: Compiled, store: StateStore, frontier: list[int], lo: in
         if hit is not None:
             return new, (hit, lo + a + len(ends))
     return new, None
-
-
-def _layer_native(store: StateStore, lo: int, hi: int, nat: Native, model: Model):
-    """The states lo .. hi-1 with the compiled search, straight into the store, a call at a time
-    (a call stops when the arrays are full): None, or (hit, hit id)."""
-    i = lo
-    while i < hi:
-        got = nat.bfs(store, i, hi, model)
-        i = got.done
-        if got.kind == HIT_RANGE:
-            raise RangeError(got.message)
-        if got.hit() is not None:
-            return got.hit(), i
-    return None
 
 
 def _next_layer(store: StateStore, layer_starts: list[int], bar: Progress | None, lo: int, width: int) -> None:

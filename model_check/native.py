@@ -328,7 +328,7 @@ void preds(int64_t k0, int64_t k1, const uint8_t *rows, int64_t n, int64_t width
         n_rules = len(self.model.rules)
         R = max(n_rules, 1)
         rule_t = "uint8_t" if n_rules <= 256 else "uint16_t"      # storage.StateStore's rule array
-        out = ["typedef struct { int64_t done, edges, distinct, kind, index, rule, var, value; } Res;",
+        out = ["typedef struct { int64_t done, edges, distinct, kind, index, rule, var, value, layers; } Res;",
                "#define EMIT(RI) do { memcpy(succ + (size_t)k * W, t, sizeof t); sr[k++] = (RI); } while (0)",
                "/* the successors of s in rule order (canonical), their rules; -1 on a range hit (r says it) */",
                "static int64_t gen(const U *s, U *succ, int32_t *sr, Res *r) {",
@@ -380,12 +380,17 @@ void expand(const U *front, int64_t n, U *out, int32_t *inv, int32_t *rules, int
    (keys up to klimit, edges up to ecap): the caller grows the arrays and calls again. */
 void bfs(int64_t i, int64_t stop, uint8_t *keys, int64_t nk, int64_t klimit, int64_t width,
          int32_t *parent, int32_t *table, int64_t tbits, int32_t *dst, {rule_t} *rules, int64_t ne,
-         int64_t ecap, uint16_t *degree, Res *r) {{
+         int64_t ecap, uint16_t *degree, int64_t *layers, int64_t lcap, Res *r) {{
     U tmask = ((U)1 << tbits) - 1, s[W];
     U succ[NRULES * W]; int32_t sr[NRULES];
     uint8_t tb[W * 8];
+    int64_t nl = 0;
     r->kind = 0;
-    for (; i < stop; i++) {{
+    for (;; i++) {{
+        if (i == stop) {{             /* the layer is done: the next is the states it found */
+            if (nk == stop || nl == lcap) break;
+            layers[nl++] = stop = nk;
+        }}
         if (nk + NRULES > klimit || ne + NRULES > ecap) {{ r->kind = {HIT_FULL}; break; }}
         const uint8_t *row = keys + (size_t)i * (size_t)width;
         memset(s, 0, sizeof s);
@@ -415,7 +420,7 @@ void bfs(int64_t i, int64_t stop, uint8_t *keys, int64_t nk, int64_t klimit, int
         }}
         degree[i] = (uint16_t)k;
     }}
-    r->done = i; r->edges = ne; r->distinct = nk;
+    r->done = i; r->edges = ne; r->distinct = nk; r->layers = nl;
 }}""")
         return out
 
@@ -425,7 +430,8 @@ class _LRes(ctypes.Structure):
 
 
 class _Res(ctypes.Structure):
-    _fields_ = [(f, ctypes.c_int64) for f in ("done", "edges", "distinct", "kind", "index", "rule", "var", "value")]
+    _fields_ = [(f, ctypes.c_int64) for f in ("done", "edges", "distinct", "kind", "index", "rule", "var", "value",
+                                              "layers")]
 
 
 @dataclass
@@ -469,6 +475,7 @@ class Stop(NamedTuple):
     kind: int                    # HIT_* (HIT_FULL: arrays full, grow them and call again)
     index: int                   # invariant index (HIT_INVARIANT)
     message: str                 # HIT_RANGE: the RangeError's text
+    layers: list[int]            # where each layer the call went on to ends (first id after it)
 
     def hit(self) -> tuple | None:
         return _hit(self.kind, self.index, None)
@@ -483,6 +490,7 @@ class Native:
         self.fn.restype = None
         self.cap = 0
         self.res = _Res()
+        self.layers = np.empty(1 << 10, np.int64)       # layer ends of one `bfs` call
 
     def _buffers(self, states: int) -> None:
         """Sized for `states` states at most (a small model's search stays small: issue 12's
@@ -513,29 +521,31 @@ class Native:
 
 
     def bfs(self, store: StateStore, i: int, stop: int, model: Model) -> Stop:
-        """Expand the stored states i .. stop-1 into `store` (new states, parents, edges, degrees)
-        until done, a hit, or full arrays (then `Stop.done` < stop: call again; the arrays grow
-        by a quarter before each call that needs it)."""
+        """Expand the stored states from i on, layer after layer (the current one ends before
+        `stop`), into `store` (new states, parents, edges, degrees), until no new states, a hit,
+        or full arrays (then call again from `Stop.done`; the arrays grow by a quarter before
+        each call that needs it)."""
         fn = self.lib.bfs
         fn.restype = None
         room = self.n_rules
-        store.reserve(room, room, stop)
+        store.reserve(room, room, 0)
         keys, parent, dst, rule, degree = store.keys, store.parent, store.dst, store.rule, store.degree
         if degree.n != i:
             raise ValueError(f"bfs: state {i} expanded out of order ({degree.n} expanded)")
         klimit = min(len(keys.data), len(parent.data), int(LOAD * len(store.table)))
+        degree.reserve(klimit - degree.n)            # every state stored by the end can be expanded
         ecap = min(len(dst.data), len(rule.data))
         p, n64 = ctypes.c_void_p, ctypes.c_int64
         fn(n64(i), n64(stop), p(keys.data.ctypes.data), n64(keys.n), n64(klimit), n64(store.width),
            p(parent.data.ctypes.data), p(store.table.ctypes.data), n64(store.table_bits),
            p(dst.data.ctypes.data), p(rule.data.ctypes.data), n64(dst.n), n64(ecap), p(degree.data.ctypes.data),
-           ctypes.byref(self.res))
+           p(self.layers.ctypes.data), n64(len(self.layers)), ctypes.byref(self.res))
         r = self.res
         keys.n = parent.n = int(r.distinct)
         dst.n = rule.n = int(r.edges)
         degree.n = int(r.done)
         message = range_message(model, int(r.rule), int(r.var), int(r.value)) if r.kind == HIT_RANGE else ""
-        return Stop(int(r.done), int(r.kind), int(r.index), message)
+        return Stop(int(r.done), int(r.kind), int(r.index), message, self.layers[:r.layers].tolist())
 
     def predicates(self, k0: int, k1: int, rows: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Predicates k0 .. k1-1 of `predicate_texts` (at most 32) in each stored byte row
