@@ -374,6 +374,12 @@ void expand(const U *front, int64_t n, U *out, int32_t *inv, int32_t *rules, int
     }}
     r->done = i; r->edges = ne; r->distinct = nd;
 }}
+/* storage.mix64 of the row t, the top tbits bits: its first slot in the table */
+#define HASH_SLOT() \\
+    U hh = t[0] * 0x9E3779B97F4A7C15ULL; \\
+    for (int q = 1; q < W; q++) hh = (hh ^ (hh >> 31) ^ t[q]) * 0xBF58476D1CE4E5B9ULL; \\
+    hh = (hh ^ (hh >> 29)) * 0x94D049BB133111EBULL; \\
+    U slot = hh >> (64 - tbits)
 /* bfs: expand the stored states i .. stop-1 (ids in breadth-first order) into the store itself
    (storage.StateStore): its hash table (mix64, triangular probing: the same slots as numpy's),
    byte rows, parents, edges and degrees. Stops before a state whose successors might not fit
@@ -399,10 +405,7 @@ void bfs(int64_t i, int64_t stop, uint8_t *keys, int64_t nk, int64_t klimit, int
         if (k < 0) break;
         for (int64_t j = 0; j < k; j++) {{
             const U *t = succ + (size_t)j * W;
-            U hh = t[0] * 0x9E3779B97F4A7C15ULL;
-            for (int q = 1; q < W; q++) hh = (hh ^ (hh >> 31) ^ t[q]) * 0xBF58476D1CE4E5B9ULL;
-            hh = (hh ^ (hh >> 29)) * 0x94D049BB133111EBULL;
-            U slot = hh >> (64 - tbits);
+            HASH_SLOT();
             for (int64_t b = 0; b < width; b++) tb[b] = (uint8_t)(t[b >> 3] >> (8 * (b & 7)));
             int32_t got;
             for (U step = 1;; step++) {{
@@ -421,6 +424,18 @@ void bfs(int64_t i, int64_t stop, uint8_t *keys, int64_t nk, int64_t klimit, int
         degree[i] = (uint16_t)k;
     }}
     r->done = i; r->edges = ne; r->distinct = nk; r->layers = nl;
+}}
+/* the hash table of the stored rows 0 .. n-1 (distinct), as bfs probes it */
+void rehash(const uint8_t *keys, int64_t n, int64_t width, int32_t *table, int64_t tbits) {{
+    U tmask = ((U)1 << tbits) - 1, t[W];
+    for (int64_t i = 0; i < n; i++) {{
+        const uint8_t *row = keys + (size_t)i * (size_t)width;
+        memset(t, 0, sizeof t);
+        for (int64_t j = 0; j < width; j++) t[j >> 3] |= (U)row[j] << (8 * (j & 7));
+        HASH_SLOT();
+        for (U step = 1; table[slot] >= 0; step++) slot = (slot + step) & tmask;
+        table[slot] = (int32_t)i;
+    }}
 }}""")
         return out
 
@@ -527,6 +542,7 @@ class Native:
         each call that needs it)."""
         fn = self.lib.bfs
         fn.restype = None
+        store.rehash = self.rehash
         room = self.n_rules
         store.reserve(room, room, 0)
         keys, parent, dst, rule, degree = store.keys, store.parent, store.dst, store.rule, store.degree
@@ -546,6 +562,12 @@ class Native:
         degree.n = int(r.done)
         message = range_message(model, int(r.rule), int(r.var), int(r.value)) if r.kind == HIT_RANGE else ""
         return Stop(int(r.done), int(r.kind), int(r.index), message, self.layers[:r.layers].tolist())
+
+    def rehash(self, keys: np.ndarray, table: np.ndarray, bits: int) -> None:
+        """Fill the empty `table` (int32, 2^bits slots) with the ids of the stored byte rows."""
+        p, n64 = ctypes.c_void_p, ctypes.c_int64
+        self.lib.rehash.restype = None
+        self.lib.rehash(p(keys.ctypes.data), n64(len(keys)), n64(keys.shape[1]), p(table.ctypes.data), n64(bits))
 
     def predicates(self, k0: int, k1: int, rows: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Predicates k0 .. k1-1 of `predicate_texts` (at most 32) in each stored byte row

@@ -174,6 +174,8 @@ class StateStore:
         self.table: np.ndarray | None = np.full(1 << 12, -1, np.int32)
         self.offsets: np.ndarray | None = None
         self.rules = rules
+        # (keys, empty table, its bits) -> table filled with ids 0..: set by the compiled search
+        self.rehash: Callable[[np.ndarray, np.ndarray, int], None] | None = None
 
     def __len__(self) -> int:
         return self.keys.n
@@ -239,6 +241,9 @@ class StateStore:
         self.table = None                             # the old table goes before the new one comes
         self.table = np.full(size, -1, np.int32)
         keys = self.keys.view
+        if self.rehash is not None:                   # the compiled search's: no temporaries at all
+            self.rehash(keys, self.table, self.table_bits)
+            return
         for lo in range(0, len(self), REHASH):        # in slices: the hash temporaries stay small
             rows = self._unpack(keys[lo:lo + REHASH])
             self._claim(self._hash(rows).astype(np.int64), np.arange(lo, lo + len(rows), dtype=np.int32),
