@@ -83,7 +83,7 @@ def table(family: str, ns: list[int], use_spin: bool) -> None:
             if not plain.stored == coll.stored == states:
                 print(f"STATE COUNTS DIFFER: ours {states}, SPIN {plain.stored}, COLLAPSE {coll.stored}")
             line += (f"{plain.seconds:>9.2f}{plain.memory_mb:>9.1f}{coll.seconds:>9.2f}{coll.memory_mb:>9.1f}"
-                     f"{secs / max(plain.seconds, 1e-3):>8.1f}{secs / max(coll.seconds, 1e-3):>8.1f}"
+                     f"{secs / max(plain.seconds, 1e-3):>8.3f}{secs / max(coll.seconds, 1e-3):>8.3f}"
                      f"{row['mb'] / max(plain.memory_mb, 1e-3):>8.2f}{row['mb'] / max(coll.memory_mb, 1e-3):>8.2f}")
             row.update(spin_s=plain.seconds, spin_mb=plain.memory_mb, coll_s=coll.seconds, coll_mb=coll.memory_mb)
         print(line, flush=True)
