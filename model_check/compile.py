@@ -12,8 +12,7 @@ liveness) still use that plain scheme.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-from functools import cache
+from dataclasses import dataclass, field
 from typing import Callable
 
 from model_check import expr, fastgen, native
@@ -46,6 +45,16 @@ def layout_of(model: Model) -> Layout:
         pos += v.bits
     return Layout(shift, width, pos)
 
+class _NoNative:
+    """The reference path's stand-in for native.Builder: no compiled model."""
+
+    def __call__(self) -> None:
+        return None
+
+    def cached(self) -> bool:
+        return False
+
+
 @dataclass
 class Compiled:
     """The generated functions and the source they came from (kept for debugging)."""
@@ -59,7 +68,8 @@ class Compiled:
     predicates: dict[str, Callable[[int], bool]]
     source: str
     edges: Callable | None = None   # (frontier, nxt, rules, ends) -> hit: one layer's edges (storage)
-    native: Callable[[], native.Native | None] = lambda: None   # the C successor function, built on first call
+    native: Callable[[], native.Native | None] = field(default_factory=_NoNative)   # the C successor function, built on first call
+    # (a native.Builder: also says with `cached()` whether building it costs a compiler run)
 
 def _unpack_lines(model: Model, lay: Layout, indent: str, src: str = "s") -> list[str]:
     return _var_lines(model, lay, indent, src) + [
@@ -163,8 +173,8 @@ def compile_model(model: Model, optimise: bool = True) -> Compiled:
                     successors=namespace["successors"], canon=namespace["canon"],
                     predicates={k: namespace[f"pred_{k}"] for k in preds}, source=source,
                     edges=namespace["edges"],
-                    native=cache(lambda: native.build(model, lay.shift, lay.width, lay.total_bits)) if optimise
-                    else (lambda: None))
+                    native=native.Builder(model, lay.shift, lay.width, lay.total_bits) if optimise
+                    else _NoNative())
 
 def _reference_expand(model: Model, lay: Layout, sym: bool, edges: bool = False) -> list[str]:
     """The straightforward `expand`: decode everything, every guard in turn, one set lookup per edge

@@ -49,6 +49,7 @@ class Result:
     store_bytes: int = 0                       # bytes of the stored graph (states, parents, edges)
     cpu: float = 0.0                           # CPU seconds of the whole check (search and properties)
     proof: bool = True                         # False after a bitstate search: a pass proves nothing
+    native: Native | None = None               # the compiled model the search ended on (None: Python)
 
     @property
     def ok(self) -> bool:
@@ -66,8 +67,11 @@ class Result:
 
     @property
     def bytes_per_state(self) -> float:
-        """Resident peak per state: the figure that matters on big models (fixed overheads
-        dominate it on tiny ones, where `store_bytes_per_state` is the per-state cost)."""
+        """The summary line's bytes/state: the resident memory the check added at its peak
+        (VmHWM, reset at the check's start, minus VmRSS then: the interpreter, the imports and
+        the spec are not counted; the search, the stored graph and the property passes are)
+        over the states. Fixed costs (arrays' initial capacity, 4 KiB pages) dominate it on tiny
+        models, where `store_bytes_per_state` is the per-state cost."""
         return self.peak_bytes / max(self.states, 1)
 
     @property
@@ -113,8 +117,9 @@ class Progress:
 
 
 def explore(model: Model, compiled: Compiled | None = None, progress: bool = True,
-            check_liveness: bool = True) -> Result:
-    """Explore every reachable state; stop at the first safety violation."""
+            check_liveness: bool = True, use_native: bool | None = None) -> Result:
+    """Explore every reachable state; stop at the first safety violation. `use_native`: True
+    compiles the model for C at once, False never, None from NATIVE_AFTER states (see _search)."""
     comp = compiled or compile_model(model)
     res = Result(model=model, compiled=comp, coverage=[0] * len(model.rules))
     if model.symmetry and model.responses and check_liveness:
@@ -126,13 +131,13 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
     store = StateStore(comp.layout.total_bits, len(model.rules))
     store.add_initial(comp.init)
     res.layer_starts = [0, 1]
-    hit, hit_id = _search(model, comp, store, res.layer_starts, bar, res.times)
+    hit, hit_id, res.native = _search(model, comp, store, res.layer_starts, bar, res.times, use_native)
     res.store_bytes = store.nbytes         # before finish drops the hash table: the search's peak
     store.finish()
     res.store = store
     res.seconds = time.perf_counter() - t0
     # CPU seconds: comparable on a busy machine
-    res.times = {"search": time.process_time() - c0, **res.times}
+    res.times = {"search": time.process_time() - c0 - res.times.pop("compile, in process", 0.0), **res.times}
     res.coverage = store.coverage()
     res.states, res.transitions, res.depth = len(store), sum(res.coverage), len(res.layer_starts) - 2
     try:
@@ -156,35 +161,62 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
 
 
 def _search(model: Model, comp: Compiled, store: StateStore, layer_starts: list[int], bar: Progress | None,
-            times: dict[str, float]) -> tuple[tuple | None, int]:
-    """Breadth-first layers; (hit, id of the hit state) or (None, -1).
+            times: dict[str, float], use_native: bool | None) -> tuple[tuple | None, int, Native | None]:
+    """Breadth-first layers; (hit, id of the hit state, the compiled model used or None), hit None
+    and id -1 when there is none.
 
-    Layers start on the generated Python `edges`; once the search has NATIVE_AFTER states it
-    goes on with the compiled C successor function (model_check.native), if there is one: a
-    small model never pays for a compiler run, a big one gets C speed. Both give the same ids,
-    parents, edges and hits, so where the switch happens changes no result."""
-    frontier: list[int] | np.ndarray = [comp.init]
-    lo, nat, tried = 0, None, False
-    while len(frontier):
-        if nat is None and not tried and len(store) >= NATIVE_AFTER:
-            tried, before = True, _child_cpu()
-            nat = comp.native()
-            times["compile"] = _child_cpu() - before      # the C compiler's CPU (0 when it was cached)
-            if nat is not None:
-                frontier = store.to_words(frontier)
-        new, hit = (_layer_native(model, store, frontier, lo, nat) if nat is not None
-                    else _layer_python(comp, store, frontier, lo))
+    The compiled C search (model_check.native) runs from the first state when its shared object
+    is in the cache or `use_native` is True, else once the search has NATIVE_AFTER states (a small
+    model never waits for a compiler run); before that, and without a compiler or with
+    `use_native` False, the generated Python `edges`. Both give the same ids, parents, edges and
+    hits, so where the switch happens changes no result. Generating and compiling the C is timed
+    apart ("compile", own and compiler CPU), not as search: SPIN's pan.c compile is not its search."""
+    frontier: list[int] = [comp.init]
+    lo, nat, tried = 0, None, use_native is False
+    while True:
+        if not tried:
+            before, own = _cpu(), time.process_time()
+            if use_native or len(store) >= NATIVE_AFTER or comp.native.cached():  # type: ignore[attr-defined]
+                tried, nat = True, comp.native()
+            times["compile"] = times.get("compile", 0.0) + _cpu() - before
+            # explore takes this off the search
+            times["compile, in process"] = times.get("compile, in process", 0.0) + time.process_time() - own
+        if nat is not None:           # breadth-first order is id order: the layer is ids lo .. len-1
+            return (*_search_native(model, store, lo, nat, layer_starts, bar), nat)
+        hi = len(store)
+        frontier, hit = _layer_python(comp, store, frontier, lo)
         if hit is not None:
-            return hit
-        lo += len(frontier)
-        frontier = new
-        _next_layer(store, layer_starts, bar, lo, len(frontier))
-    return None, -1
+            return (*hit, nat)
+        lo = hi
+        if len(store) == hi:
+            return None, -1, nat
+        _next_layer(store, layer_starts, bar, lo, len(store) - hi)
 
 
-def _child_cpu() -> float:
+def _search_native(model: Model, store: StateStore, lo: int, nat: Native, layer_starts: list[int],
+                   bar: Progress | None) -> tuple[tuple | None, int]:
+    """The rest of the search from the layer of ids lo .. len(store)-1 with the compiled search,
+    straight into the store, a call at a time (a call goes on over layers and stops when the
+    arrays are full): (hit, hit id) or (None, -1)."""
+    i, stop = lo, len(store)
+    while True:
+        got = nat.bfs(store, i, stop, model)
+        i = got.done
+        for end in got.layers:           # the layers this call began (the ones before ended in it)
+            _next_layer(store, layer_starts, bar, stop, end - stop)
+            stop = end
+        if got.kind == HIT_RANGE:
+            raise RangeError(got.message)
+        if got.hit() is not None:
+            return got.hit(), i
+        if i == stop == len(store):
+            return None, -1
+
+
+def _cpu() -> float:
+    """CPU seconds of this process and its finished children (the C compiler)."""
     t = os.times()
-    return t.children_user + t.children_system
+    return t.user + t.system + t.children_user + t.children_system
 
 
 def _layer_python(comp: Compiled, store: StateStore, frontier: list[int], lo: int):
@@ -202,23 +234,6 @@ def _layer_python(comp: Compiled, store: StateStore, frontier: list[int], lo: in
         if hit is not None:
             return new, (hit, lo + a + len(ends))
     return new, None
-
-
-def _layer_native(model: Model, store: StateStore, frontier: np.ndarray, lo: int, nat: Native):
-    """One layer with the C successor function, a call at a time (a call stops when its buffers
-    are full): (next frontier rows, None) or (_, (hit, hit id))."""
-    new: list[np.ndarray] = []
-    a = 0
-    while a < len(frontier):
-        chunk = nat.expand(frontier[a:a + SLICE])
-        fresh = store.add_edges(lo + a, chunk.distinct, chunk.inv, chunk.rules, chunk.ends)
-        new.append(chunk.distinct[fresh])
-        a += chunk.done
-        if chunk.kind == HIT_RANGE:
-            raise RangeError(chunk.range_message(model))
-        if chunk.hit() is not None:
-            return new, (chunk.hit(), lo + a)
-    return (np.concatenate(new) if new else frontier[:0]), None
 
 
 def _next_layer(store: StateStore, layer_starts: list[int], bar: Progress | None, lo: int, width: int) -> None:

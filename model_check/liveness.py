@@ -20,12 +20,13 @@ from __future__ import annotations
 
 import time
 from collections import deque
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
+from model_check import native
 from model_check.storage import pieces, ranges
 from model_check.trace import Violation, concretise, follow
 
@@ -34,8 +35,17 @@ if TYPE_CHECKING:
 
 
 def check_responses(res: Result) -> None:
-    graph = _Graph(res)
+    """Every response in turn, on the compiled pass (model_check.native) where the search had
+    one; a violation's counterexample, and everything without it, comes from the numpy algorithm
+    below (both decide the same: tests/model_check/test_native.py)."""
+    fast = _Native(res) if res.native is not None else None
+    graph: _Graph | None = None
     for index, resp in enumerate(res.model.responses):
+        answer = fast.check(index) if fast is not None else None
+        if answer is not None:
+            res.bounds[resp.name] = answer.bound
+            continue
+        graph = graph or _Graph(res)
         bound, violation = check_response(res, index, graph)
         res.bounds[resp.name] = bound
         if violation is not None:
@@ -43,12 +53,10 @@ def check_responses(res: Result) -> None:
             return
 
 
-class _Graph:
-    """What every response of one result shares: per-rule fairness bits and ticks, the reverse edges."""
+class _Rules:
+    """Per rule: its fairness group (actor), the group's bit, and its ticks."""
 
-    def __init__(self, res: Result):
-        model, store = res.model, res._graph()
-        t = time.process_time()
+    def __init__(self, model):
         self.actors = [r.actor for r in model.rules]
         groups = sorted({a for a in self.actors if a is not None})
         if len(groups) > 64:       # pragma: no cover - no model comes close
@@ -56,6 +64,60 @@ class _Graph:
         bit = {g: 1 << k for k, g in enumerate(groups)}
         self.bit = np.array([bit.get(a, 0) for a in self.actors] or [0], np.uint64)
         self.ticks = np.array([r.ticks for r in model.rules] or [0], np.int32)
+
+
+class _Answer(NamedTuple):
+    bound: int | None          # the response bound K in ticks; None: holds under weak fairness only
+
+
+class _Native(_Rules):
+    """The responses on the compiled pass: triggers and goals of 16 responses at a time
+    evaluated in C in one pass over the stored states (bits of a uint32 per state), then per
+    response one iterative Tarjan over B that yields the bound K, or decides weak fairness per
+    cyclic component; 12 bytes per state of work arrays, no reverse graph."""
+
+    GROUP = 16                 # responses whose trigger and goal share one uint32 per state
+
+    def __init__(self, res: Result):
+        super().__init__(res.model)
+        self.res, self.nat, self.store = res, res.native, res._graph()
+        n = len(self.store)
+        self.mask = np.empty(n, np.uint32)
+        self.work = np.empty((2, n), np.int32)
+        self.group = -1
+
+    def decide(self, index: int) -> tuple[int, int]:
+        """(native.L_* kind, bound) of response `index`."""
+        t = time.process_time()
+        group, k = divmod(index, self.GROUP)
+        if group != self.group:       # predicate 1 + 2i is response i's trigger, 2 + 2i its goal
+            first = 1 + 2 * group * self.GROUP
+            last = min(first + 2 * self.GROUP, 1 + 2 * len(self.res.model.responses))
+            self.nat.predicates(first, last, self.store.keys.view, self.mask)
+            self.group = group
+        t = _tick(self.res, "liveness", t)
+        st = self.store
+        kind, bound = self.nat.respond(st.offsets, st.dst.view, st.rule.view, self.mask, 2 * k, 2 * k + 1,
+                                       self.ticks, self.bit, self.work)
+        _tick(self.res, "bounds" if kind == native.L_BOUND else "liveness", t)
+        return kind, bound
+
+    def check(self, index: int) -> _Answer | None:
+        """The answer, or None where the numpy algorithm must say it (a violation: it builds the
+        counterexample; or the C pass ran out of memory or int32 ticks)."""
+        kind, bound = self.decide(index)
+        if kind == native.L_BOUND:
+            return _Answer(bound)
+        return _Answer(None) if kind == native.L_FAIR_ONLY else None
+
+
+class _Graph(_Rules):
+    """What every response of one result shares: per-rule fairness bits and ticks, the reverse edges."""
+
+    def __init__(self, res: Result):
+        model, store = res.model, res._graph()
+        t = time.process_time()
+        super().__init__(model)
         n = len(store)
         rev = csr_matrix((store.rule.view, store.dst.view, store.offsets), shape=(n, n)).tocsc()
         self.rev_ptr, self.rev_src, self.rev_rule = rev.indptr, rev.indices, rev.data
@@ -190,15 +252,17 @@ def _bfs_path(start: int, goal_test, adj, allowed: set[int] | None) -> list[int]
     while queue:
         u = queue.popleft()
         for _, v in adj(u):
-            if v in parent or (allowed is not None and v not in allowed):
+            if allowed is not None and v not in allowed:
                 continue
-            parent[v] = u
-            if goal_test(v):
+            if goal_test(v):           # `start` too: a cycle back to it (a self-loop) is a path
                 path = [v]
-                while parent[path[-1]] != start:
-                    path.append(parent[path[-1]])
+                while u != start:
+                    path.append(u)
+                    u = parent[u]
                 return path[::-1]
-            queue.append(v)
+            if v not in parent:
+                parent[v] = u
+                queue.append(v)
     raise RuntimeError("no path")  # pragma: no cover
 
 

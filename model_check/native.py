@@ -33,14 +33,17 @@ import hashlib
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
 from model_check import expr
 from model_check.gcl import Model
+from model_check.storage import LOAD, StateStore
 
 CC_FLAGS = ("-O1", "-shared", "-fPIC", "-std=c99", "-w")
 HIT_NONE, HIT_INVARIANT, HIT_DEADLOCK, HIT_RANGE, HIT_FULL = 0, 1, 2, 3, 4
@@ -122,6 +125,109 @@ static inline I pmod(I a, I b) { I r = a % b; return (r != 0 && ((r < 0) != (b <
 """
 
 
+def predicate_texts(model: Model) -> list[str]:
+    """The predicates the C code evaluates over stored states: `final`, then each response's
+    trigger and goal (index 1 + 2k and 2 + 2k)."""
+    return [model.final] + [t for r in model.responses for t in (r.trigger, r.goal)]
+
+
+# Response checks on the stored graph (model_check.liveness's algorithm in one pass, issue 12):
+# B = the states reachable from a trigger state (not a goal state) without passing a goal state.
+# An iterative Tarjan over B finds its strongly connected components in reverse topological
+# order, so when B is acyclic each state's longest tick path to the goal is known when its
+# component closes (the bound K); a cyclic component is checked for weak fairness (every group
+# enabled in all its states is taken inside it) there and then. Numbers only: no spec text.
+L_BOUND, L_FAIR_ONLY, L_VIOLATION, L_NOMEM, L_OVERFLOW = 0, 1, 2, 3, 4
+_GRAPH_COMMON = """\
+#include <stdlib.h>
+typedef struct { int64_t kind, bound; } LRes;
+typedef struct { int32_t node, k; } Frame;
+#define GOAL(V) ((mask[V] >> gb) & 1u)
+#define TRIG(V) ((mask[V] >> tb) & 1u)
+static int reserve(void **p, int64_t *cap, int64_t need, size_t size) {
+    if (need <= *cap) return 1;
+    int64_t c = *cap ? *cap : 4096;
+    while (c < need) c *= 2;
+    void *q = realloc(*p, (size_t)c * size);
+    if (!q) return 0;
+    *p = q; *cap = c; return 1;
+}
+#define PUSH(V) do { int32_t v_ = (V); \\
+    if (off[v_ + 1] == off[v_]) { r->kind = %d; goto out; } \\
+    if (!reserve((void **)&stk, &scap, sp + 1, sizeof *stk) || !reserve((void **)&fr, &fcap, cp + 1, sizeof *fr)) \\
+        { r->kind = %d; goto out; } \\
+    idx[v_] = low[v_] = counter++; stk[sp++] = v_; fr[cp].node = v_; fr[cp].k = 0; cp++; } while (0)
+""" % (L_VIOLATION, L_NOMEM)
+_GRAPH = """\
+void NAME(int64_t n, const OT *off, const int32_t *dst, const RT *rule, const uint32_t *mask, int64_t tb, int64_t gb,
+          const int32_t *ticks, const U *bit, int32_t *idx, int32_t *low, LRes *r) {
+    int32_t *stk = 0; Frame *fr = 0;
+    int64_t scap = 0, fcap = 0, sp = 0, cp = 0;
+    int32_t counter = 0;
+    int cyclic = 0;
+    r->kind = %(bound)d; r->bound = 0;
+    for (int64_t i = 0; i < n; i++) idx[i] = -1;
+    for (int64_t root = 0; root < n; root++) {
+        if (!TRIG(root) || GOAL(root) || idx[root] != -1) continue;
+        PUSH((int32_t)root);
+        while (cp > 0) {
+            Frame *f = &fr[cp - 1];
+            int32_t u = f->node;
+            OT e = (OT)(off[u] + f->k);
+            if (e < off[u + 1]) {
+                f->k++;
+                int32_t v = dst[e];
+                if (GOAL(v)) continue;
+                if (idx[v] == -1) PUSH(v);
+                else if (idx[v] >= 0 && idx[v] < low[u]) low[u] = idx[v];
+                continue;
+            }
+            cp--;
+            if (cp > 0 && low[u] < low[fr[cp - 1].node]) low[fr[cp - 1].node] = low[u];
+            if (low[u] != idx[u]) continue;
+            /* u roots a component: stk[base .. sp-1]; a successor outside it is closed (idx -2) */
+            int64_t base = sp - 1;
+            while (stk[base] != u) base--;
+            int self = 0;
+            U always = ~(U)0, taken = 0;
+            int64_t longest = 0;
+            for (int64_t q = base; q < sp; q++) {
+                int32_t w = stk[q];
+                U en = 0;
+                for (OT x = off[w]; x < off[w + 1]; x++) {
+                    int32_t v = dst[x];
+                    U b = bit[rule[x]];
+                    int64_t c = ticks[rule[x]];
+                    en |= b;
+                    if (GOAL(v)) { if (c > longest) longest = c; continue; }
+                    if (idx[v] >= idx[u]) { taken |= b; self |= v == w; }
+                    else if (c + low[v] > longest) longest = c + low[v];
+                }
+                always &= en;
+            }
+            if (sp - base == 1 && !self) {
+                if (longest > INT32_MAX) { r->kind = %(overflow)d; goto out; }
+                low[u] = (int32_t)longest;
+            } else {
+                cyclic = 1;
+                if ((always & ~taken) == 0) { r->kind = %(violation)d; goto out; }   /* a weakly fair cycle */
+                for (int64_t q = base; q < sp; q++) low[stk[q]] = 0;
+            }
+            for (int64_t q = base; q < sp; q++) idx[stk[q]] = -2;
+            sp = base;
+        }
+    }
+    if (cyclic) r->kind = %(fair)d;
+    else
+        for (int64_t i = 0; i < n; i++)
+            if (TRIG(i) && !GOAL(i) && low[i] > r->bound) r->bound = low[i];
+out:
+    free(stk);
+    free(fr);
+}
+""" % {"bound": L_BOUND, "overflow": L_OVERFLOW, "violation": L_VIOLATION, "fair": L_FAIR_ONLY}
+
+
 class _Src:
     """The C text of one model, from its variables' bit fields (compile.Layout)."""
 
@@ -137,7 +243,7 @@ class _Src:
 
     def source(self) -> str:
         m, W = self.model, self.words
-        out = [_PRELUDE, f"#define W {W}"]
+        out = [_PRELUDE, _GRAPH_COMMON, f"#define W {W}"]
         for n, text in m.defs:                  # definitions: pure functions of the state
             out.append(f"static inline I d_{n}(const U *s) {{ return {_c(expr.parse(text), self.name)}; }}")
         out += self.canon()
@@ -147,7 +253,32 @@ class _Src:
         out.append("    return -1;\n}")
         out.append(f"static inline int is_final(const U *s) {{ return ({_c(expr.parse(m.final), self.name)}) != 0; }}")
         out += self.search()
+        out += self.predicates()
+        out += [_GRAPH.replace("OT", o).replace("RT", r).replace("NAME", f"respond_{o}_{r}")
+                for o in ("int32_t", "int64_t") for r in ("uint8_t", "uint16_t")]
         return "\n".join(out) + "\n"
+
+    def predicates(self) -> list[str]:
+        """`pred(k, rows, ...)`: predicate k of `predicate_texts` over stored byte rows (storage)."""
+        texts = predicate_texts(self.model)
+        out = [f"static int p_{k}(const U *s) {{ return ({_c(expr.parse(t), self.name)}) != 0; }}"
+               for k, t in enumerate(texts)]
+        out.append("typedef int (*Pred)(const U *);")
+        out.append("static const Pred PREDS[] = {" + ", ".join(f"p_{k}" for k in range(len(texts))) + "};")
+        out.append("""\
+/* predicates k0 .. k1-1 (at most 32) in each stored row: bit k - k0 of out[i] */
+void preds(int64_t k0, int64_t k1, const uint8_t *rows, int64_t n, int64_t width, uint32_t *out) {
+    U s[W];
+    for (int64_t i = 0; i < n; i++) {
+        const uint8_t *row = rows + (size_t)i * (size_t)width;
+        memset(s, 0, sizeof s);
+        for (int64_t j = 0; j < width; j++) s[j >> 3] |= (U)row[j] << (8 * (j & 7));   /* little-endian rows */
+        uint32_t m = 0;
+        for (int64_t k = k0; k < k1; k++) m |= (uint32_t)PREDS[k](s) << (k - k0);
+        out[i] = m;
+    }
+}""")
+        return out
 
     def canon(self) -> list[str]:
         """Sort each symmetry group's blocks ascending, in the group order (compile._canon_source)."""
@@ -189,51 +320,133 @@ class _Src:
             out.append(f"            setb(t, {self.shift[target]}u, {self.width[target]}u, (U){local});")
         if m.symmetry:
             out.append("            canon(t);")
-        out.append(f"            EDGE({ri});")
+        out.append(f"            EMIT({ri});")
         out.append("        }")
         return out
 
     def search(self) -> list[str]:
         n_rules = len(self.model.rules)
-        out = ["""\
-typedef struct { int64_t done, edges, distinct, kind, index, rule, var, value; } Res;
-#define EDGE(RI) do { \\
-    U hh = 0x9E3779B97F4A7C15ULL; \\
-    for (int q = 0; q < W; q++) { hh ^= t[q]; hh *= 0xBF58476D1CE4E5B9ULL; hh ^= hh >> 31; } \\
-    U slot = hh & tmask; \\
-    int32_t got; \\
-    for (U step = 1;; step++) { \\
-        got = table[slot]; \\
-        if (got < 0) { got = (int32_t)nd; table[slot] = got; memcpy(out + (size_t)nd * W, t, sizeof t); nd++; break; } \\
-        if (memcmp(out + (size_t)got * W, t, sizeof t) == 0) break; \\
-        slot = (slot + step) & tmask; \\
-    } \\
-    inv[ne] = got; rules[ne] = (RI); ne++; \\
-} while (0)
-""",
-               "void expand(const U *front, int64_t n, U *out, int32_t *inv, int32_t *rules, int64_t *ends,",
-               "            int64_t cap, int32_t *table, int64_t tsize, Res *r) {",
-               "    U tmask = (U)tsize - 1; int64_t ne = 0, nd = 0, i = 0; U t[W];",
-               "    r->kind = 0;",
-               "    for (; i < n; i++) {",
-               f"        if (ne + {max(n_rules, 1)} > cap) {{ r->kind = {HIT_FULL}; break; }}",
-               "        const U *s = front + (size_t)i * W;",
-               "        int bad = inv_fail(s);",
-               f"        if (bad >= 0) {{ r->kind = {HIT_INVARIANT}; r->index = bad; break; }}",
-               "        int en = 0;"]
+        R = max(n_rules, 1)
+        rule_t = "uint8_t" if n_rules <= 256 else "uint16_t"      # storage.StateStore's rule array
+        out = ["typedef struct { int64_t done, edges, distinct, kind, index, rule, var, value, layers; } Res;",
+               "#define EMIT(RI) do { memcpy(succ + (size_t)k * W, t, sizeof t); sr[k++] = (RI); } while (0)",
+               "/* the successors of s in rule order (canonical), their rules; -1 on a range hit (r says it) */",
+               "static int64_t gen(const U *s, U *succ, int32_t *sr, Res *r) {",
+               "    int64_t k = 0; U t[W]; int en = 0;"]
         for ri in range(n_rules):
             out += self.rule(ri)
-        out += [f"        if (!en && !is_final(s)) {{ r->kind = {HIT_DEADLOCK}; break; }}",
-                "        ends[i] = ne;",
-                "    }",
-                "stop:",
-                "    r->done = i; r->edges = ne; r->distinct = nd;",
-                "}"]
+        out += ["    (void)en;", "    return k;", "stop:", "    return -1;", "}"]
+        out.append(f"""\
+#define NRULES {R}
+/* one state's check before its successors: 0 to go on, else the hit is in r */
+static inline int64_t visit(const U *s, U *succ, int32_t *sr, Res *r) {{
+    int bad = inv_fail(s);
+    if (bad >= 0) {{ r->kind = {HIT_INVARIANT}; r->index = bad; return -1; }}
+    int64_t k = gen(s, succ, sr, r);
+    if (k == 0 && !is_final(s)) {{ r->kind = {HIT_DEADLOCK}; return -1; }}
+    return k;
+}}
+/* expand: frontier rows, successors deduplicated within the call (model_check.parallel, bitstate) */
+void expand(const U *front, int64_t n, U *out, int32_t *inv, int32_t *rules, int64_t *ends,
+            int64_t cap, int32_t *table, int64_t tsize, Res *r) {{
+    U tmask = (U)tsize - 1; int64_t ne = 0, nd = 0, i = 0;
+    U succ[NRULES * W]; int32_t sr[NRULES];
+    r->kind = 0;
+    for (; i < n; i++) {{
+        if (ne + NRULES > cap) {{ r->kind = {HIT_FULL}; break; }}
+        int64_t k = visit(front + (size_t)i * W, succ, sr, r);
+        if (k < 0) break;
+        for (int64_t j = 0; j < k; j++) {{
+            const U *t = succ + (size_t)j * W;
+            U hh = 0x9E3779B97F4A7C15ULL;
+            for (int q = 0; q < W; q++) {{ hh ^= t[q]; hh *= 0xBF58476D1CE4E5B9ULL; hh ^= hh >> 31; }}
+            U slot = hh & tmask;
+            int32_t got;
+            for (U step = 1;; step++) {{
+                got = table[slot];
+                if (got < 0) {{ got = (int32_t)nd; table[slot] = got; memcpy(out + (size_t)nd * W, t, W * sizeof(U)); nd++; break; }}
+                if (memcmp(out + (size_t)got * W, t, W * sizeof(U)) == 0) break;
+                slot = (slot + step) & tmask;
+            }}
+            inv[ne] = got; rules[ne] = sr[j]; ne++;
+        }}
+        ends[i] = ne;
+    }}
+    r->done = i; r->edges = ne; r->distinct = nd;
+}}
+/* storage.mix64 of the row t, the top tbits bits: its first slot in the table */
+#define HASH_SLOT() \\
+    U hh = t[0] * 0x9E3779B97F4A7C15ULL; \\
+    for (int q = 1; q < W; q++) hh = (hh ^ (hh >> 31) ^ t[q]) * 0xBF58476D1CE4E5B9ULL; \\
+    hh = (hh ^ (hh >> 29)) * 0x94D049BB133111EBULL; \\
+    U slot = hh >> (64 - tbits)
+/* bfs: expand the stored states i .. stop-1 (ids in breadth-first order) into the store itself
+   (storage.StateStore): its hash table (mix64, triangular probing: the same slots as numpy's),
+   byte rows, parents, edges and degrees. Stops before a state whose successors might not fit
+   (keys up to klimit, edges up to ecap): the caller grows the arrays and calls again. */
+void bfs(int64_t i, int64_t stop, uint8_t *keys, int64_t nk, int64_t klimit, int64_t width,
+         int32_t *parent, int32_t *table, int64_t tbits, int32_t *dst, {rule_t} *rules, int64_t ne,
+         int64_t ecap, uint16_t *degree, int64_t *layers, int64_t lcap, Res *r) {{
+    U tmask = ((U)1 << tbits) - 1, s[W];
+    U succ[NRULES * W]; int32_t sr[NRULES];
+    uint8_t tb[W * 8];
+    int64_t nl = 0;
+    r->kind = 0;
+    for (;; i++) {{
+        if (i == stop) {{             /* the layer is done: the next is the states it found */
+            if (nk == stop || nl == lcap) break;
+            layers[nl++] = stop = nk;
+        }}
+        if (nk + NRULES > klimit || ne + NRULES > ecap) {{ r->kind = {HIT_FULL}; break; }}
+        const uint8_t *row = keys + (size_t)i * (size_t)width;
+        memset(s, 0, sizeof s);
+        for (int64_t j = 0; j < width; j++) s[j >> 3] |= (U)row[j] << (8 * (j & 7));
+        int64_t k = visit(s, succ, sr, r);
+        if (k < 0) break;
+        for (int64_t j = 0; j < k; j++) {{
+            const U *t = succ + (size_t)j * W;
+            HASH_SLOT();
+            for (int64_t b = 0; b < width; b++) tb[b] = (uint8_t)(t[b >> 3] >> (8 * (b & 7)));
+            int32_t got;
+            for (U step = 1;; step++) {{
+                got = table[slot];
+                if (got < 0) {{
+                    got = (int32_t)nk; table[slot] = got;
+                    memcpy(keys + (size_t)nk * (size_t)width, tb, (size_t)width);
+                    parent[nk] = (int32_t)i; nk++;
+                    break;
+                }}
+                if (memcmp(keys + (size_t)got * (size_t)width, tb, (size_t)width) == 0) break;
+                slot = (slot + step) & tmask;
+            }}
+            dst[ne] = got; rules[ne] = ({rule_t})sr[j]; ne++;
+        }}
+        degree[i] = (uint16_t)k;
+    }}
+    r->done = i; r->edges = ne; r->distinct = nk; r->layers = nl;
+}}
+/* the hash table of the stored rows 0 .. n-1 (distinct), as bfs probes it */
+void rehash(const uint8_t *keys, int64_t n, int64_t width, int32_t *table, int64_t tbits) {{
+    U tmask = ((U)1 << tbits) - 1, t[W];
+    for (int64_t i = 0; i < n; i++) {{
+        const uint8_t *row = keys + (size_t)i * (size_t)width;
+        memset(t, 0, sizeof t);
+        for (int64_t j = 0; j < width; j++) t[j >> 3] |= (U)row[j] << (8 * (j & 7));
+        HASH_SLOT();
+        for (U step = 1; table[slot] >= 0; step++) slot = (slot + step) & tmask;
+        table[slot] = (int32_t)i;
+    }}
+}}""")
         return out
 
 
+class _LRes(ctypes.Structure):
+    _fields_ = [("kind", ctypes.c_int64), ("bound", ctypes.c_int64)]
+
+
 class _Res(ctypes.Structure):
-    _fields_ = [(f, ctypes.c_int64) for f in ("done", "edges", "distinct", "kind", "index", "rule", "var", "value")]
+    _fields_ = [(f, ctypes.c_int64) for f in ("done", "edges", "distinct", "kind", "index", "rule", "var", "value",
+                                              "layers")]
 
 
 @dataclass
@@ -252,25 +465,47 @@ class Chunk:
     value: int = 0
 
     def hit(self, state: int | None = None) -> tuple | None:
-        """The violation as the Python `edges` reports it: (kind, index, state), or None."""
-        if self.kind == HIT_INVARIANT:
-            return ("invariant", self.index, state)
-        return ("deadlock", -1, state) if self.kind == HIT_DEADLOCK else None
+        return _hit(self.kind, self.index, state)
 
     def range_message(self, model: Model) -> str:
-        """HIT_RANGE: the RangeError's text, as the Python `edges` words it."""
-        return f"{model.rules[self.rule].name}: {model.vars[self.var].name} = {self.value}"
+        return range_message(model, self.rule, self.var, self.value)
+
+
+def _hit(kind: int, index: int, state: int | None) -> tuple | None:
+    """The violation as the Python `edges` reports it: (kind, index, state), or None."""
+    if kind == HIT_INVARIANT:
+        return ("invariant", index, state)
+    return ("deadlock", -1, state) if kind == HIT_DEADLOCK else None
+
+
+def range_message(model: Model, rule: int, var: int, value: int) -> str:
+    """HIT_RANGE: the RangeError's text, as the Python `edges` words it."""
+    return f"{model.rules[rule].name}: {model.vars[var].name} = {value}"
+
+
+class Stop(NamedTuple):
+    """Why and where `Native.bfs` stopped."""
+
+    done: int                    # the first state not expanded
+    kind: int                    # HIT_* (HIT_FULL: arrays full, grow them and call again)
+    index: int                   # invariant index (HIT_INVARIANT)
+    message: str                 # HIT_RANGE: the RangeError's text
+    layers: list[int]            # where each layer the call went on to ends (first id after it)
+
+    def hit(self) -> tuple | None:
+        return _hit(self.kind, self.index, None)
 
 
 class Native:
     """A compiled model: `expand(rows)` runs the C function over a slice of frontier rows."""
 
     def __init__(self, lib: ctypes.CDLL, words: int, rules: int):
-        self.words, self.n_rules = words, max(rules, 1)
+        self.lib, self.words, self.n_rules = lib, words, max(rules, 1)
         self.fn = lib.expand
         self.fn.restype = None
         self.cap = 0
         self.res = _Res()
+        self.layers = np.empty(1 << 10, np.int64)       # layer ends of one `bfs` call
 
     def _buffers(self, states: int) -> None:
         """Sized for `states` states at most (a small model's search stays small: issue 12's
@@ -300,6 +535,71 @@ class Native:
                      int(r.rule), int(r.var), int(r.value))
 
 
+    def bfs(self, store: StateStore, i: int, stop: int, model: Model) -> Stop:
+        """Expand the stored states from i on, layer after layer (the current one ends before
+        `stop`), into `store` (new states, parents, edges, degrees), until no new states, a hit,
+        or full arrays (then call again from `Stop.done`; the arrays grow by a quarter before
+        each call that needs it)."""
+        fn = self.lib.bfs
+        fn.restype = None
+        store.rehash = self.rehash
+        room = self.n_rules
+        store.reserve(room, room, 0)
+        keys, parent, dst, rule, degree = store.keys, store.parent, store.dst, store.rule, store.degree
+        if degree.n != i:
+            raise ValueError(f"bfs: state {i} expanded out of order ({degree.n} expanded)")
+        klimit = min(len(keys.data), len(parent.data), int(LOAD * len(store.table)))
+        degree.reserve(klimit - degree.n)            # every state stored by the end can be expanded
+        ecap = min(len(dst.data), len(rule.data))
+        p, n64 = ctypes.c_void_p, ctypes.c_int64
+        fn(n64(i), n64(stop), p(keys.data.ctypes.data), n64(keys.n), n64(klimit), n64(store.width),
+           p(parent.data.ctypes.data), p(store.table.ctypes.data), n64(store.table_bits),
+           p(dst.data.ctypes.data), p(rule.data.ctypes.data), n64(dst.n), n64(ecap), p(degree.data.ctypes.data),
+           p(self.layers.ctypes.data), n64(len(self.layers)), ctypes.byref(self.res))
+        r = self.res
+        keys.n = parent.n = int(r.distinct)
+        dst.n = rule.n = int(r.edges)
+        degree.n = int(r.done)
+        message = range_message(model, int(r.rule), int(r.var), int(r.value)) if r.kind == HIT_RANGE else ""
+        return Stop(int(r.done), int(r.kind), int(r.index), message, self.layers[:r.layers].tolist())
+
+    def rehash(self, keys: np.ndarray, table: np.ndarray, bits: int) -> None:
+        """Fill the empty `table` (int32, 2^bits slots) with the ids of the stored byte rows."""
+        p, n64 = ctypes.c_void_p, ctypes.c_int64
+        self.lib.rehash.restype = None
+        self.lib.rehash(p(keys.ctypes.data), n64(len(keys)), n64(keys.shape[1]), p(table.ctypes.data), n64(bits))
+
+    def predicates(self, k0: int, k1: int, rows: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """Predicates k0 .. k1-1 of `predicate_texts` (at most 32) in each stored byte row
+        (storage.StateStore.keys): bit k - k0 of a uint32 per row."""
+        if not 0 <= k0 <= k1 <= k0 + 32:
+            raise ValueError(f"predicates {k0} .. {k1 - 1}: at most 32 at a time")
+        rows = np.ascontiguousarray(rows, np.uint8)
+        res = np.empty(len(rows), np.uint32) if out is None else out
+        p, n64 = ctypes.c_void_p, ctypes.c_int64
+        self.lib.preds(n64(k0), n64(k1), p(rows.ctypes.data), n64(len(rows)), n64(rows.shape[1]), p(res.ctypes.data))
+        return res
+
+    def respond(self, offsets: np.ndarray, dst: np.ndarray, rule: np.ndarray, mask: np.ndarray, trigger: int,
+                goal: int, ticks: np.ndarray, bit: np.ndarray, work: np.ndarray) -> tuple[int, int]:
+        """One response on the stored CSR graph: (L_* kind, bound K when L_BOUND). Its trigger
+        and goal are bits `trigger` and `goal` of `mask` (uint32 per state, see `predicates`);
+        `ticks` int32 and `bit` uint64 per rule; `work` int32 of shape (2, states), overwritten."""
+        fn = getattr(self.lib, f"respond_{'int32_t' if offsets.dtype == np.int32 else 'int64_t'}_"
+                               f"{'uint8_t' if rule.dtype == np.uint8 else 'uint16_t'}")
+        fn.restype = None
+        for a, dtype in ((offsets, offsets.dtype), (dst, np.int32), (rule, rule.dtype), (mask, np.uint32),
+                         (ticks, np.int32), (bit, np.uint64), (work, np.int32)):
+            if a.dtype != dtype or not a.flags.c_contiguous:
+                raise TypeError(f"respond: an array of {a.dtype}, not contiguous {np.dtype(dtype)}")
+        out = _LRes()
+        p, n64 = ctypes.c_void_p, ctypes.c_int64
+        fn(n64(len(mask)), p(offsets.ctypes.data), p(dst.ctypes.data), p(rule.ctypes.data), p(mask.ctypes.data),
+           n64(trigger), n64(goal), p(ticks.ctypes.data), p(bit.ctypes.data), p(work[0].ctypes.data),
+           p(work[1].ctypes.data), ctypes.byref(out))
+        return int(out.kind), int(out.bound)
+
+
 def c_source(model: Model, shift: dict[str, int], width: dict[str, int], total_bits: int) -> str:
     """The C source of `model`'s successor function (raises Unsupported)."""
     if any(w > 64 for w in width.values()):
@@ -307,31 +607,56 @@ def c_source(model: Model, shift: dict[str, int], width: dict[str, int], total_b
     return _Src(model, shift, width, total_bits).source()
 
 
-def build(model: Model, shift: dict[str, int], width: dict[str, int], total_bits: int) -> Native | None:
-    """The compiled successor function, or None (no compiler, an untranslated construct, or
-    ARACHNAE_NATIVE=0 in the environment): the caller then uses the Python one."""
-    if os.environ.get("ARACHNAE_NATIVE", "1") == "0":
-        return None
-    cc = shutil.which(os.environ.get("CC", "cc"))
-    if cc is None:
-        return None
-    try:
-        src = c_source(model, shift, width, total_bits)
-    except Unsupported:
-        return None
-    digest = hashlib.sha256((src + " ".join(CC_FLAGS)).encode()).hexdigest()[:24]
-    cache = _cache_dir()
-    lib = cache / f"succ_{digest}.so"
-    if not lib.exists():
-        try:
-            cache.mkdir(parents=True, exist_ok=True)
-            with tempfile.TemporaryDirectory(dir=cache) as tmp:
-                c_file, so = Path(tmp) / "succ.c", Path(tmp) / "succ.so"
-                c_file.write_text(src)
-                subprocess.run([cc, *CC_FLAGS, "-o", str(so), str(c_file)], check=True,
-                               capture_output=True, timeout=300)
-                os.replace(so, lib)             # atomic: a concurrent run sees all of it or nothing
-        except (OSError, subprocess.SubprocessError):
+class Builder:
+    """The compiled model of one Compiled, made on the first call and kept (None where there is
+    no compiler, an untranslated construct, or ARACHNAE_NATIVE=0 in the environment: the caller
+    then uses the Python successor function). `cached()` says whether a call costs no compiler
+    run, so a search can use C from its first state."""
+
+    def __init__(self, model: Model, shift: dict[str, int], width: dict[str, int], total_bits: int):
+        self.model, self.shift, self.width, self.total_bits = model, shift, width, total_bits
+        self.done, self.native = False, None
+        self._lib: Path | None | bool = False          # False: not worked out yet
+
+    def lib(self) -> Path | None:
+        """Where the shared object of this model is (or goes), None if there is none to be had."""
+        if self._lib is False:
+            self._lib = None
+            if os.environ.get("ARACHNAE_NATIVE", "1") != "0" and sys.byteorder == "little":
+                try:
+                    self.src = c_source(self.model, self.shift, self.width, self.total_bits)
+                    digest = hashlib.sha256((self.src + " ".join(CC_FLAGS)).encode()).hexdigest()[:24]
+                    self._lib = _cache_dir() / f"succ_{digest}.so"
+                except Unsupported:
+                    pass
+        return self._lib      # type: ignore[return-value]
+
+    def cached(self) -> bool:
+        lib = self.lib()
+        return self.done or (lib is not None and lib.exists())
+
+    def __call__(self) -> Native | None:
+        if not self.done:
+            self.done, self.native = True, self._build()
+        return self.native
+
+    def _build(self) -> Native | None:
+        lib = self.lib()
+        if lib is None:
             return None
-    words = max(1, -(-total_bits // 64))
-    return Native(ctypes.CDLL(str(lib)), words, len(model.rules))
+        if not lib.exists():
+            cc = shutil.which(os.environ.get("CC", "cc"))
+            if cc is None:
+                return None
+            try:
+                lib.parent.mkdir(parents=True, exist_ok=True)
+                with tempfile.TemporaryDirectory(dir=lib.parent) as tmp:
+                    c_file, so = Path(tmp) / "succ.c", Path(tmp) / "succ.so"
+                    c_file.write_text(self.src)
+                    subprocess.run([cc, *CC_FLAGS, "-o", str(so), str(c_file)], check=True,
+                                   capture_output=True, timeout=300)
+                    os.replace(so, lib)             # atomic: a concurrent run sees all of it or nothing
+            except (OSError, subprocess.SubprocessError):
+                return None
+        words = max(1, -(-self.total_bits // 64))
+        return Native(ctypes.CDLL(str(lib)), words, len(self.model.rules))

@@ -28,6 +28,7 @@ from __future__ import annotations
 import ast
 import ctypes
 import ctypes.util
+import functools
 from itertools import repeat
 from typing import Callable
 
@@ -68,9 +69,15 @@ def _trim() -> None:
     """Give the C heap's free pages back to the system (glibc malloc_trim), so that arrays of
     the check cannot hide in memory an earlier step freed and the peak counts them all."""
     try:
-        ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6").malloc_trim(0)
+        _libc().malloc_trim(0)
     except (OSError, AttributeError):       # not glibc: the peak may then under-count
         pass
+
+
+@functools.cache
+def _libc() -> ctypes.CDLL:
+    """The C library, looked up once (find_library runs ldconfig: 15 ms a time)."""
+    return ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
 
 
 def _status(key: str) -> int:
@@ -101,11 +108,16 @@ class Grow:
 
     def append(self, chunk: np.ndarray) -> None:
         need = self.n + len(chunk)
+        self.reserve(len(chunk))
+        self.data[self.n:need] = chunk
+        self.n = need
+
+    def reserve(self, extra: int) -> None:
+        """Capacity for `extra` more rows (grown by a quarter at least, as `append` does)."""
+        need = self.n + extra
         if need > len(self.data):
             cap = max(need, len(self.data) + len(self.data) // 4)
             self.data.resize((cap, self.width) if self.width else cap, refcheck=False)
-        self.data[self.n:need] = chunk
-        self.n = need
 
     def trim(self) -> None:
         """Capacity down to the length (no more appends are expected; they would still work)."""
@@ -162,6 +174,8 @@ class StateStore:
         self.table: np.ndarray | None = np.full(1 << 12, -1, np.int32)
         self.offsets: np.ndarray | None = None
         self.rules = rules
+        # (keys, empty table, its bits) -> table filled with ids 0..: set by the compiled search
+        self.rehash: Callable[[np.ndarray, np.ndarray, int], None] | None = None
 
     def __len__(self) -> int:
         return self.keys.n
@@ -201,11 +215,22 @@ class StateStore:
 
     # -- hashing -------------------------------------------------------------------------
     def _hash(self, rows: np.ndarray) -> np.ndarray:
-        return mix64(rows) >> np.uint64(64 - self._bits)
+        return mix64(rows) >> np.uint64(64 - self.table_bits)
 
     @property
-    def _bits(self) -> int:
+    def table_bits(self) -> int:
         return len(self.table).bit_length() - 1      # type: ignore[arg-type]
+
+    def reserve(self, states: int, edges: int, expanded: int) -> None:
+        """Room for `states` more states and `edges` more edges, degrees of states up to
+        `expanded`, and a hash table that takes `states` more at its load limit (for a caller
+        that writes into the arrays itself: the compiled search, model_check.native)."""
+        for g in (self.keys, self.parent):
+            g.reserve(states)
+        for g in (self.dst, self.rule):
+            g.reserve(edges)
+        self.degree.reserve(expanded - self.degree.n)
+        self._grow_table(len(self) + states)
 
     def _grow_table(self, need: int) -> None:
         size = len(self.table)                        # type: ignore[arg-type]
@@ -216,6 +241,9 @@ class StateStore:
         self.table = None                             # the old table goes before the new one comes
         self.table = np.full(size, -1, np.int32)
         keys = self.keys.view
+        if self.rehash is not None:                   # the compiled search's: no temporaries at all
+            self.rehash(keys, self.table, self.table_bits)
+            return
         for lo in range(0, len(self), REHASH):        # in slices: the hash temporaries stay small
             rows = self._unpack(keys[lo:lo + REHASH])
             self._claim(self._hash(rows).astype(np.int64), np.arange(lo, lo + len(rows), dtype=np.int32),

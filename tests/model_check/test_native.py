@@ -10,12 +10,12 @@ import random
 import numpy as np
 import pytest
 
-from model_check import engine, native
+from model_check import engine, liveness, native, storage
 from model_check import spec_adapter as sa
 from model_check.compile import RangeError, compile_model
 from model_check.engine import explore
-from model_check.gcl import Model, Rule, SymGroup, Var
-from model_check.models import post
+from model_check.gcl import Model, Response, Rule, SymGroup, Var
+from model_check.models import arbitration, id_retry, post
 from model_check.storage import StateStore
 from tests.model_check import toys
 from tests.model_check.test_fastgen import MODELS, _reference_step, _same
@@ -64,14 +64,37 @@ def test_native_successors_of_random_states_equal_reference(spec, build):
 @pytest.mark.parametrize("after", [0, 5])
 @pytest.mark.parametrize("build", [b for _, b in SMALL], ids=[n for n, _ in SMALL])
 def test_native_search_equals_reference(spec, build, after, monkeypatch):
-    """From the first state (0) or mid-search (5), with calls stopped by tiny buffers."""
+    """From the first state (0) or mid-search (5), with calls stopped by full arrays after
+    (nearly) every state (the store's arrays grow by exactly what a call asks for) and by a
+    full buffer of layer ends."""
     model = build(spec)
     ref = explore(model, compile_model(model, optimise=False), progress=False)
     monkeypatch.setattr(engine, "NATIVE_AFTER", after)
     monkeypatch.setattr(native, "MAX_EDGES", 7)
+
+    class Tight(storage.Grow):
+        def __init__(self, dtype, width=0, capacity=1):
+            super().__init__(dtype, width, 1)
+
+        def reserve(self, extra):
+            if self.n + extra > len(self.data):
+                self.data.resize((self.n + extra, self.width) if self.width else self.n + extra, refcheck=False)
+    monkeypatch.setattr(storage, "Grow", Tight)
+    init = native.Native.__init__
+
+    def one_layer(self, *a):          # a call ends after the first layer it began, as when its buffer is full
+        init(self, *a)
+        self.layers = self.layers[:1]
+    monkeypatch.setattr(native.Native, "__init__", one_layer)
+    calls = []
+    bfs = native.Native.bfs
+    monkeypatch.setattr(native.Native, "bfs", lambda self, *a: calls.append(a[1]) or bfs(self, *a))
     comp = compile_model(model)
+    monkeypatch.setattr(comp.native, "cached", lambda: False)     # so the switch is at `after` states
     got = explore(model, comp, progress=False)
     assert comp.native() is not None and "compile" in got.times
+    assert (bool(calls) and min(calls) == 0) == (after == 0)     # from the start, or after Python
+    assert after or not got.ok or len(calls) >= got.states // 2   # stopped by full arrays, not layers
     _same(got, ref)
     assert got.store.parent.view.tolist() == ref.store.parent.view.tolist()
     assert got.store.dst.view.tolist() == ref.store.dst.view.tolist()
@@ -110,3 +133,70 @@ def test_post_oracle_screen_equals_the_oracle(spec):
     bulk = post.oracle_screen(p, t, names, {k: np.array([v[k] for v in views]) for k in views[0]})
     assert bulk.tolist() == [post.oracle_mismatch(p, t, names, v) is not None for v in views]
     assert 0 < bulk.sum() < len(views)
+
+
+def _dead_end() -> Model:
+    """A trigger state whose run can end (a final state) before the goal: a liveness violation."""
+    vs = [Var("x", 3), Var("g", 1)]
+    rules = [Rule("go", "x < 2", (("x", "x + 1"),), actor="a", ticks=2),
+             Rule("hit", "x == 1", (("g", "1"), ("x", "3")), actor="a", ticks=5)]
+    return Model("dead_end", vs, rules, final="x >= 2", responses=[Response("goal", "x == 1", "g == 1")])
+
+
+def _random_responses(seed: int) -> Model:
+    """A random graph over small counters with many random responses: bounded ones, cycles fair
+    and unfair, dead ends -- every verdict of the response check occurs."""
+    rng = random.Random(seed)
+    hi = {"a": 5, "b": 5, "c": 1}
+    vs = [Var(n, h) for n, h in hi.items()]
+    rules = []
+    for k in range(12):
+        v, w = rng.choice(list(hi)), rng.choice(list(hi))
+        guard = f"{w} {rng.choice(('==', '!=', '<', '>'))} {rng.randint(0, hi[w])}"
+        effect = rng.choice((f"({v} + 1) % {hi[v] + 1}", str(rng.randint(0, hi[v])), f"{hi[v]} - {v}",
+                             f"({v} + {w}) % {hi[v] + 1}"))
+        rules.append(Rule(f"r{k}", guard, ((v, effect),), actor=rng.choice(("p", "q", None)),
+                          ticks=rng.randint(0, 3)))
+    cmp = ("==", "!=", "<", ">")
+    responses = [Response(f"resp{k}", f"{rng.choice('ab')} {rng.choice(cmp)} {rng.randint(0, 5)}",
+                          f"{rng.choice('ab')} {rng.choice(cmp)} {rng.randint(0, 5)}") for k in range(40)]
+    return Model(f"random{seed}", vs, rules, final="c == 1", responses=responses)
+
+
+def _idle_loop() -> Model:
+    """A self-loop of no fairness group after the trigger: a fair cycle of one state (its lasso
+    goes round the self-loop)."""
+    rules = [Rule("start", "a == 0", (("a", "1"),), actor="p", ticks=1), Rule("idle", "a == 1", (("a", "1"),))]
+    return Model("idle_loop", [Var("a", 2)], rules, responses=[Response("back", "a == 1", "a == 2")])
+
+
+RESPONDING = [("idle-loop", lambda s: _idle_loop()), ("countdown", lambda s: toys.countdown(4)), ("countdown-stutter", lambda s: toys.countdown(4, True)),
+              ("spin-forever", lambda s: toys.spin_forever()), ("dead-end", lambda s: _dead_end()),
+              ("arb-colliders-2", lambda s: arbitration.build(sa.arbitration(s, "sensor", "colliders"), "spec", 2)),
+              ("id-first-2", lambda s: id_retry.build(sa.identification(s, "first"), 2))] + [
+              (f"random-{k}", lambda s, k=k: _random_responses(k)) for k in (0, 3, 4)]
+
+
+@pytest.mark.parametrize("build", [b for _, b in RESPONDING], ids=[n for n, _ in RESPONDING])
+def test_native_responses_decide_as_the_numpy_algorithm(spec, build, monkeypatch):
+    """Per response, the C pass's verdict (bound K, fair-only, violation) is the numpy algorithm's,
+    and a whole check gives the same bounds and counterexample on either."""
+    model = build(spec)
+    ref = explore(model, compile_model(model, optimise=False), progress=False)
+    monkeypatch.setattr(engine, "NATIVE_AFTER", 0)
+    got = explore(model, progress=False)
+    assert got.native is not None and ref.native is None
+    assert got.bounds == ref.bounds
+    _same(got, ref)
+    kinds = set()
+    fast, graph = liveness._Native(ref), liveness._Graph(ref)
+    fast.nat = got.native
+    for index in range(len(model.responses)):
+        bound, violation = liveness.check_response(ref, index, graph)
+        kinds.add("violation" if violation else "fair-only" if bound is None else "bound")
+        kind, k = fast.decide(index)
+        assert (kind, k if kind == native.L_BOUND else None) == (
+            (native.L_VIOLATION, None) if violation else
+            (native.L_FAIR_ONLY, None) if bound is None else (native.L_BOUND, bound)), model.responses[index]
+    if model.name.startswith("random"):
+        assert kinds == {"violation", "fair-only", "bound"}, kinds

@@ -67,7 +67,7 @@ def test_edges_and_coverage_match_the_compiled_successors():
         lo, hi = int(store.offsets[i]), int(store.offsets[i + 1])
         got = list(zip(store.rule.view[lo:hi].tolist(), store.states(store.dst.view[lo:hi])))
         assert got == [(r, comp.canon(ns)) for r, ns in comp.successors(s)]
-    assert res.bytes_per_state >= 0 and set(res.times) == {"search", "bounds", "liveness"}
+    assert res.bytes_per_state >= 0 and set(res.times) - {"compile"} == {"search", "bounds", "liveness"}
 
 
 def test_slicing_wide_layers_changes_nothing(monkeypatch):
