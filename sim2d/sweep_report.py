@@ -1,7 +1,8 @@
 """`arachnae sweep report RESULTS` (issue 14): how often a sweep's expectations hold, and what predicts failure.
 
 Pass rate per expectation with a Wilson 95 % interval (sound at small counts and at 0 % / 100 %, where the
-normal approximation collapses); failure rate per parameter bin; the worst runs with their replay
+normal approximation collapses); failure rate per parameter bin; a table per base scenario (passes, which
+expectation failed on which seeds, worst reaction, collisions, falls); the worst runs with their replay
 command; PNG bar charts (Pillow, already a dependency) and report.md in the results folder.
 """
 from __future__ import annotations
@@ -92,6 +93,59 @@ def worst_runs(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
                                           r["run_id"]))[:WORST]
 
 
+@dataclass(frozen=True)
+class ScenarioRow:
+    """One base scenario's runs: the pass table the session note carries (issue 14 item 5, issue 17)."""
+    scenario: str
+    runs: int
+    passed: int
+    failures: dict[str, list[int]]       # expectation -> seeds it failed on
+    worst_reaction: tuple[float, int] | None    # (max_reaction_s, seed), None: no stimulus or not collected
+    collided: tuple[int, int] | None     # (runs with a collision, most contacts in one run), None: not collected
+    falls: int | None                    # runs that fell, None: not collected
+
+
+def per_scenario(rows: list[dict[str, Any]]) -> list[ScenarioRow]:
+    """Per base scenario, in table order: passes, which expectation failed on which seeds, the worst reaction,
+    collisions and falls (the last three only when the sweep collected max_reaction_s, collisions, fell)."""
+    out = []
+    for name in dict.fromkeys(r["scenario"] for r in rows):
+        mine = [r for r in rows if r["scenario"] == name]
+        failures: dict[str, list[int]] = {}
+        for r in mine:
+            for key, ok in r.items():
+                if key.startswith("expect.") and ok is False:
+                    failures.setdefault(key.removeprefix("expect."), []).append(r["seed"])
+            if r["error"]:
+                failures.setdefault("error", []).append(r["seed"])
+        reactions = [(r["metric.max_reaction_s"], r["seed"]) for r in mine if r.get("metric.max_reaction_s") is not None]
+        contacts = [r["metric.collisions"] for r in mine if r.get("metric.collisions") is not None]
+        fell = [r["metric.fell"] for r in mine if r.get("metric.fell") is not None]
+        out.append(ScenarioRow(Path(name).stem, len(mine), sum(bool(r["passed"]) for r in mine), failures,
+                               max(reactions) if reactions else None,
+                               (sum(c > 0 for c in contacts), max(contacts)) if contacts else None,
+                               sum(bool(f) for f in fell) if fell else None))
+    return out
+
+
+def _seed_list(seeds: list[int]) -> str:
+    return ", ".join(str(s) for s in sorted(seeds))
+
+
+def scenario_table(rows: list[dict[str, Any]]) -> list[str]:
+    """The per-scenario table as markdown lines."""
+    lines = ["| scenario | passed | failed expectations (seeds) | worst reaction | collisions (runs, most contacts) "
+             "| falls |", "|---|---:|---|---|---|---:|"]
+    for s in per_scenario(rows):
+        failed = "; ".join(f"{n} ({_seed_list(seeds)})" for n, seeds in s.failures.items()) or "-"
+        reaction = f"{s.worst_reaction[0]:.2f} s (seed {s.worst_reaction[1]})" if s.worst_reaction else "-"
+        collided = f"{s.collided[0]} runs, {s.collided[1]}" if s.collided and s.collided[0] else \
+            ("0" if s.collided else "-")
+        lines.append(f"| {s.scenario} | {s.passed}/{s.runs} | {failed} | {reaction} | {collided} | "
+                     f"{'-' if s.falls is None else s.falls} |")
+    return lines
+
+
 def bar_chart(title: str, rates: list[Rate], path: Path, what: str) -> None:
     """Horizontal bars of rates with their Wilson intervals as whiskers (Pillow)."""
     from PIL import Image, ImageDraw
@@ -132,7 +186,9 @@ def write_report(results: Path) -> Path:
              "## Pass rate per expectation (Wilson 95 % interval)", "", "| expectation | runs | passed | rate [95 % CI] |",
              "|---|---:|---:|---|"]
     lines += [f"| {r.label} | {r.n} | {r.k} | {_pct(r)} |" for r in passes]
-    lines += ["", "![pass rates](plots/pass_rates.png)", "", "## Failure rate per parameter bin", ""]
+    lines += ["", "![pass rates](plots/pass_rates.png)", "", "## Per scenario", ""]
+    lines += scenario_table(rows)
+    lines += ["", "## Failure rate per parameter bin", ""]
     for param, rates in failure_by_parameter(rows).items():
         png = f"fail_{param}.png"
         bar_chart(f"failure rate per {param}", rates, plots / png, "failure")

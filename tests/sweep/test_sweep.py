@@ -11,7 +11,7 @@ import pytest
 from arachnae.cli import main
 from arachnae.errors import UserError
 from sim2d import sweep as sw
-from sim2d.sweep_report import wilson, write_report
+from sim2d.sweep_report import scenario_table, wilson, write_report
 
 TINY = """\
 name: tiny
@@ -107,8 +107,23 @@ def test_report(two_workers: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert "| min_distance | 4 | 2 | 50.0 % [15.0, 85.0] |" in md
     assert "| MMC | 2 | 2 | 100.0 % [34.2, 100.0] |" in md and "| LCP(3) | 2 | 0 | 0.0 % [0.0, 65.8] |" in md
     assert f"arachnae sim run {two_workers / 'scenarios' / 'r000000.yaml'} --seed 1" in md
+    # per scenario: the MMC kill fails min_distance on both seeds; reaction and falls were not collected
+    assert "| tiny | 2/4 | min_distance (1, 2) | - | 0 | - |" in md
     for png in ("pass_rates.png", "fail_fault_node.png"):
         assert (two_workers / "plots" / png).read_bytes().startswith(b"\x89PNG")
+
+
+def test_scenario_table_gives_worst_reaction_collisions_and_falls() -> None:
+    """The note's pass table from a suite sweep's columns (no cluster: rows as read_table gives them)."""
+    def row(scenario: str, seed: int, reaction: float | None, contacts: int, fell: bool, ok: bool) -> dict:
+        return {"scenario": scenario, "seed": seed, "metric.max_reaction_s": reaction, "metric.collisions": contacts,
+                "metric.fell": fell, "expect.no_collision": contacts == 0, "expect.max_reaction": ok,
+                "passed": ok and contacts == 0, "error": None}
+    rows = [row("../course.yaml", 1, 0.4, 0, False, True), row("../course.yaml", 2, 1.3, 22, True, False),
+            row("../course.yaml", 3, None, 3, False, True), row("../open/ring.yaml", 1, None, 0, False, True)]
+    lines = scenario_table(rows)
+    assert lines[2] == ("| course | 1/3 | no_collision (2, 3); max_reaction (2) | 1.30 s (seed 2) | 2 runs, 22 | 1 |")
+    assert lines[3] == "| ring | 1/1 | - | - | 0 | 0 |"
 
 
 def test_wilson_known_values() -> None:
