@@ -399,7 +399,11 @@ class Runtime:
             return end - now
         if now < mine:
             return mine - now
-        if now < mine + step:
+        # a request starts inside its slot, not on the next one's edge: one begun in the slot's last bit time
+        # meets the next rank's start, and the trace (whole microseconds) puts it in the next slot (frame_loss
+        # seed 7: SPU's XMIT_REQ 9.896 ms = one slot after the corrupt frame, flagged backoff_slot). The
+        # firmware shrinks its slot by its clock tick likewise (firmware/nodes/lib/sensor.c backing_off).
+        if now < mine + step - t.bit_s:
             return 0.0
         return end - now
 

@@ -74,3 +74,21 @@ def test_usrc_takes_three_more_readings_and_only_then_declares_itself_unreliable
     rig.inject(0.6, SPU, M.StatusReq())
     rig.run(0.7)
     assert rig.frames(M.StatusAckRange)[-1][1].message.status == RangeStatus.UNRELIABLE   # seed 3.2.11, 6.2
+
+
+def test_a_request_never_starts_on_its_backoff_slots_closing_edge(spec):
+    """spec address_backoff: after a corrupt frame a slave starts only inside its own slot of the window. One
+    begun in the slot's last bit time meets the next rank's start and reads as the next slot in the trace
+    (frame_loss seed 7 on ec5018d: the SPU's XMIT_REQ exactly one slot after the corrupt frame, backoff_slot)."""
+    from behaviours.runtime import BusTiming
+
+    rig = Rig(spec, "TPSC", 0x28)                             # spec priority [TPSC, IRRC]: rank 0 on the sensor bus
+    node, t = rig.node, BusTiming("sensor")
+    assert node.rank("sensor") == 0
+    rig.run(0.5)
+    node.on_line_frame("sensor", b"\x04\x20\x46\x00\x00\x0c")  # a collision's garbage ends now: the window opens
+    end = 0.5 + len(node.net.requesters["sensor"]) * node.net.backoff_slots * t.slot_s
+    rig.run(0.5 + t.slot_s / 2)
+    assert node._backoff_wait("sensor") == 0.0                # inside slot 0: go
+    rig.run(0.5 + t.slot_s - t.bit_s / 2)
+    assert abs(node._backoff_wait("sensor") - (end - rig.board.t)) < 1e-9   # its closing edge: wait for the end
