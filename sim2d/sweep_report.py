@@ -1,7 +1,8 @@
 """`arachnae sweep report RESULTS` (issue 14): how often a sweep's expectations hold, and what predicts failure.
 
 Pass rate per expectation with a Wilson 95 % interval (sound at small counts and at 0 % / 100 %, where the
-normal approximation collapses); failure rate per parameter bin; the spread of each collected metric per
+normal approximation collapses); failure rate per parameter bin; a table per base scenario (passes, which
+expectation failed on which seeds, worst reaction, collisions, falls); the spread of each collected metric per
 scenario (what a builder sets an expectation from: issue 16 item 7); the worst runs with their replay command.
 Written as report.md and as report.html (the run report's page style, plots inlined, each worst run linked to
 its own run report in failed/RUN/), with PNG bar charts (Pillow, already a dependency) in plots/.
@@ -169,6 +170,62 @@ def _worst(results: Path, rows: list[dict[str, Any]]) -> list[WorstRun]:
     return out
 
 
+@dataclass(frozen=True)
+class ScenarioRow:
+    """One base scenario's runs: the pass table the session note carries (issue 14 item 5, issue 17)."""
+    scenario: str
+    runs: int
+    passed: int
+    failures: dict[str, list[int]]       # expectation -> seeds it failed on
+    worst_reaction: tuple[float, int] | None    # (max_reaction_s, seed), None: no stimulus or not collected
+    collided: tuple[int, int] | None     # (runs with a collision, most contacts in one run), None: not collected
+    falls: int | None                    # runs that fell, None: not collected
+
+
+def per_scenario(rows: list[dict[str, Any]]) -> list[ScenarioRow]:
+    """Per base scenario, in table order: passes, which expectation failed on which seeds, the worst reaction,
+    collisions and falls (the last three only when the sweep collected max_reaction_s, collisions, fell)."""
+    out = []
+    for name in dict.fromkeys(r["scenario"] for r in rows):
+        mine = [r for r in rows if r["scenario"] == name]
+        failures: dict[str, list[int]] = {}
+        for r in mine:
+            for key, ok in r.items():
+                if key.startswith("expect.") and ok is False:
+                    failures.setdefault(key.removeprefix("expect."), []).append(r["seed"])
+            if r["error"]:
+                failures.setdefault("error", []).append(r["seed"])
+        reactions = [(r["metric.max_reaction_s"], r["seed"]) for r in mine if r.get("metric.max_reaction_s") is not None]
+        contacts = [r["metric.collisions"] for r in mine if r.get("metric.collisions") is not None]
+        fell = [r["metric.fell"] for r in mine if r.get("metric.fell") is not None]
+        out.append(ScenarioRow(Path(name).stem, len(mine), sum(bool(r["passed"]) for r in mine), failures,
+                               max(reactions) if reactions else None,
+                               (sum(c > 0 for c in contacts), max(contacts)) if contacts else None,
+                               sum(bool(f) for f in fell) if fell else None))
+    return out
+
+
+def _seed_list(seeds: list[int]) -> str:
+    return ", ".join(str(s) for s in sorted(seeds))
+
+
+SCENARIO_HEAD = ["scenario", "passed", "failed expectations (seeds)", "worst reaction", "collisions (runs, most contacts)",
+                 "falls"]
+
+
+def scenario_cells(rows: list[dict[str, Any]]) -> list[list[str]]:
+    """The per-scenario table's cells (SCENARIO_HEAD's columns), for report.md and report.html alike."""
+    lines = []
+    for s in per_scenario(rows):
+        failed = "; ".join(f"{n} ({_seed_list(seeds)})" for n, seeds in s.failures.items()) or "-"
+        reaction = f"{s.worst_reaction[0]:.2f} s (seed {s.worst_reaction[1]})" if s.worst_reaction else "-"
+        collided = f"{s.collided[0]} runs, {s.collided[1]}" if s.collided and s.collided[0] else \
+            ("0" if s.collided else "-")
+        lines.append([s.scenario, f"{s.passed}/{s.runs}", failed, reaction, collided,
+                      "-" if s.falls is None else str(s.falls)])
+    return lines
+
+
 def bar_chart(title: str, rates: list[Rate], path: Path, what: str) -> None:
     """Horizontal bars of rates with their Wilson intervals as whiskers (Pillow)."""
     from PIL import Image, ImageDraw
@@ -216,7 +273,9 @@ def write_report(results: Path) -> Path:
     lines = [f"# Sweep report: {results}", "", f"{len(rows)} runs, {passed} passed.", "",
              "## Pass rate per expectation (Wilson 95 % interval)", ""]
     lines += _md_table(["expectation", "runs", "passed", "rate [95 % CI]"], [[r.label, r.n, r.k, r.text] for r in passes])
-    lines += ["", "![pass rates](plots/pass_rates.png)", "", "## Failure rate per parameter bin", ""]
+    lines += ["", "![pass rates](plots/pass_rates.png)", "", "## Per scenario", ""]
+    lines += _md_table(SCENARIO_HEAD, scenario_cells(rows))
+    lines += ["", "## Failure rate per parameter bin", ""]
     for param, rates in by_param.items():
         lines += [f"### {param}", ""]
         lines += _md_table(["bin", "runs", "failed", "failure rate [95 % CI]"], [[r.label, r.n, r.k, r.text] for r in rates])
@@ -235,6 +294,7 @@ def write_report(results: Path) -> Path:
     write_page(results / "report.html", "sweep_report.html.j2",
                {"results": results, "runs": len(rows), "passed": passed, "passes": passes,
                 "pass_plot": data_uri(plots / "pass_rates.png"), "spreads": spreads, "worst": worst,
+                "scenario_head": SCENARIO_HEAD, "scenario_cells": scenario_cells(rows),
                 "params": [ParamRates(p, rates, data_uri(plots / f"fail_{p}.png")) for p, rates in by_param.items()]},
                extra_dirs=[TEMPLATES])
     return md

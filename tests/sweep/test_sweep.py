@@ -11,7 +11,7 @@ import pytest
 from arachnae.cli import main
 from arachnae.errors import UserError
 from sim2d import sweep as sw
-from sim2d.sweep_report import wilson, write_report
+from sim2d.sweep_report import scenario_cells, wilson, write_report
 
 TINY = """\
 name: tiny
@@ -107,6 +107,8 @@ def test_report(two_workers: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert "| min_distance | 4 | 2 | 50.0 % [15.0, 85.0] |" in md
     assert "| MMC | 2 | 2 | 100.0 % [34.2, 100.0] |" in md and "| LCP(3) | 2 | 0 | 0.0 % [0.0, 65.8] |" in md
     assert f"arachnae sim run {two_workers / 'scenarios' / 'r000000.yaml'} --seed 1" in md
+    # per scenario: the MMC kill fails min_distance on both seeds; reaction and falls were not collected
+    assert "| tiny | 2/4 | min_distance (1, 2) | - | 0 | - |" in md
     for png in ("pass_rates.png", "fail_fault_node.png"):
         assert (two_workers / "plots" / png).read_bytes().startswith(b"\x89PNG")
     # the spread a builder sets expectations from: every run gave a distance, and a verdict word is counted
@@ -129,6 +131,20 @@ def test_report_page_links_each_failing_run_to_its_own_report(two_workers: Path)
     for run_id in failing:
         assert f'<a href="failed/{run_id}/report.html">{run_id}</a>' in page
         assert (two_workers / "failed" / run_id / "report.html").is_file()
+    assert "<td>tiny</td><td>2/4</td><td>min_distance (1, 2)</td>" in page        # the per-scenario table
+
+
+def test_scenario_table_gives_worst_reaction_collisions_and_falls() -> None:
+    """The note's pass table from a suite sweep's columns (no cluster: rows as read_table gives them)."""
+    def row(scenario: str, seed: int, reaction: float | None, contacts: int, fell: bool, ok: bool) -> dict:
+        return {"scenario": scenario, "seed": seed, "metric.max_reaction_s": reaction, "metric.collisions": contacts,
+                "metric.fell": fell, "expect.no_collision": contacts == 0, "expect.max_reaction": ok,
+                "passed": ok and contacts == 0, "error": None}
+    rows = [row("../course.yaml", 1, 0.4, 0, False, True), row("../course.yaml", 2, 1.3, 22, True, False),
+            row("../course.yaml", 3, None, 3, False, True), row("../open/ring.yaml", 1, None, 0, False, True)]
+    cells = scenario_cells(rows)
+    assert cells[0] == ["course", "1/3", "no_collision (2, 3); max_reaction (2)", "1.30 s (seed 2)", "2 runs, 22", "1"]
+    assert cells[1] == ["ring", "1/1", "-", "-", "0", "0"]
 
 
 def test_wilson_known_values() -> None:
@@ -217,3 +233,13 @@ def test_a_killed_worker_loses_no_run_and_duplicates_none(folder: Path, two_work
     rows = [json.loads(p.read_text())["run_id"] for p in sorted((out / "rows").glob("*.json"))]
     assert rows == ["r000000", "r000001", "r000002", "r000003"]
     assert _table(out) == _table(two_workers)
+
+
+def test_the_suite_sweep_lists_every_scenario(spec) -> None:
+    """make sweep-suite (issue 14): every scenario of scenarios/ and scenarios/open/, not the 60 s benchmark
+    (fault_us_killed_explore was missing from the seeds 1-20 sweep on ec5018d)."""
+    root = Path(__file__).resolve().parents[2] / "scenarios"
+    s = sw.load_sweep(root / "sweeps" / "suite.yaml", spec)
+    listed = {r.base_path for r in s.runs}
+    expected = {p.resolve() for p in [*root.glob("*.yaml"), *(root / "open").glob("*.yaml")] if p.name != "bench_60s.yaml"}
+    assert listed == expected
