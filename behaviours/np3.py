@@ -1,4 +1,4 @@
-"""NP3 (seed 3.2.3, 3.3.2, 5.1-5.2, 6): navigation as a subsumption network (decision 8).
+"""NP3 (seed 3.2.3, 3.3.2, 5.1-5.2, 6): navigation as a subsumption network (docs/decisions.md D8).
 
 The node owns the network of behaviours.np3_layers and evaluates it every
 NP3 period (and at once after a record that may need a reflex, 5.2). Its
@@ -454,7 +454,7 @@ class NP3(Runtime, Np3Skeleton):
 
     # --- debug port --------------------------------------------------------------------------------
     def debug_metrics(self) -> Np3Debug:
-        """Which layer held the MMC and for how long (decision 8), reflex take-overs, map and light figures."""
+        """Which layer held the MMC and for how long (docs/decisions.md D8), reflex take-overs, map and light figures."""
         if "move" not in self.layers.traces:
             return {"control": {}, "switches": 0, "moves_sent": 0}
         trace = self.layers.trace("move")

@@ -180,7 +180,7 @@ def steepness_deg(tilt: Any) -> float:
 
 
 def tilt_trigger(t: Tuning) -> Trigger:
-    """seed 3.2.14, decision 8: dangerous inclination -> step straight downhill (back, forward or sideways,
+    """seed 3.2.14, docs/decisions.md D8: dangerous inclination -> step straight downhill (back, forward or sideways,
     whichever is closest to the fall line), then turn until the slope is behind."""
     def trigger(i: Mapping[str, Any], now: float) -> Steps | None:
         if steepness_deg(i.get("tilt")) <= t.tilt_limit_deg:
@@ -424,7 +424,7 @@ def light_gradient(samples: list[tuple[float, float, float]], min_spread: float,
 
 
 class TaskModule:
-    """Level 2: the current task (decision 8: wall following, seeking / avoiding light, exploring)."""
+    """Level 2: the current task (docs/decisions.md D8: wall following, seeking / avoiding light, exploring)."""
 
     inputs = ("ir", "whisker", "light", "pose", "goal", "echoes")
     outputs = ("move",)
@@ -497,7 +497,7 @@ class TaskModule:
         return self._wander(now)
 
     def _wall_follow(self, i: Mapping[str, Any], now: float) -> MovCmd:
-        """Right-hand wall at a band the sonar can hold (decision 8): sidesteps keep the distance, turns the angle.
+        """Right-hand wall at a band the sonar can hold (docs/decisions.md D8): sidesteps keep the distance, turns the angle.
 
         The wall's distance and direction come from the sonar echoes seen to the
         right over the last seconds (sector minima arrive ~8 s apart per angle),

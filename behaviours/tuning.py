@@ -63,7 +63,7 @@ JAC_OVERTEMP_C = 70.0         # winding temperature flagged OVERTEMP (hobby serv
 JAC_OVERTEMP_HYST_C = 5.0     # ... until it has cooled this much below the limit
 JAC_WATCHDOG_S = 1.0          # no set point this long (5 refresh periods): the LCP is gone, the servo goes limp
 
-# --- NP3 (seed 3.2.3, 3.3.2, 5.1-5.2, 6, decision 8): the subsumption network's numbers, all CHOICE
+# --- NP3 (seed 3.2.3, 3.3.2, 5.1-5.2, 6, docs/decisions.md D8): the subsumption network's numbers, all CHOICE
 NP3_PERIOD_S = 0.1            # the network is evaluated every 100 ms (5.2: reactions well within 1 s)
 NP3_REFLEX_HOLD_S = 0.5       # suppressor time constants: reflexes ...
 NP3_AVOID_HOLD_S = 0.3        # ... and obstacle avoidance keep the lower layers cut this long

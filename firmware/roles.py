@@ -33,7 +33,7 @@ def msg_file(name: str) -> str:
 
 
 def role_msgs(spec, role: str) -> list[str]:
-    """The message files of every message the role sends or receives (decision 2: nothing else is linked)."""
+    """The message files of every message the role sends or receives (docs/decisions.md D2: nothing else is linked)."""
     names = {m.name for m in spec.sends(role)} | {m.name for m in spec.receives(role)}
     return sorted(msg_file(n) for n in names)
 

@@ -45,7 +45,7 @@ enum {
  * of AVR flash for the TPSC). Holds one of the constants above. */
 typedef uint8_t arachnae_status;
 
-/* ---- frame layout (spec frame, seed 3.2.2 / decision 1) ---- */
+/* ---- frame layout (spec frame, seed 3.2.2 / docs/decisions.md D1) ---- */
 #define ARACHNAE_FRAME_DST 0
 #define ARACHNAE_FRAME_SRC 1
 #define ARACHNAE_FRAME_OPCODE 2
