@@ -38,6 +38,7 @@ from model_check import expr
 
 LOAD = 0.7                          # grow the hash table beyond this fill
 REHASH = 1 << 18                    # states re-inserted per vectorised step when the table grows
+COUNT = 1 << 13                     # edges per bincount in `coverage` (64 KiB of int64 at a time)
 _M1 = np.uint64(0x9E3779B97F4A7C15)  # Fibonacci hashing multiplier
 _M2 = np.uint64(0xBF58476D1CE4E5B9)  # splitmix64 constants, to mix the words of a key
 _M3 = np.uint64(0x94D049BB133111EB)
@@ -118,6 +119,7 @@ class Grow:
         if need > len(self.data):
             cap = max(need, len(self.data) + len(self.data) // 4)
             self.data.resize((cap, self.width) if self.width else cap, refcheck=False)
+            _trim()       # a small block moves on the C heap: give back the one it left
 
     def trim(self) -> None:
         """Capacity down to the length (no more appends are expected; they would still work)."""
@@ -239,6 +241,7 @@ class StateStore:
         while need > LOAD * size:
             size *= 2
         self.table = None                             # the old table goes before the new one comes
+        _trim()
         self.table = np.full(size, -1, np.int32)
         keys = self.keys.view
         if self.rehash is not None:                   # the compiled search's: no temporaries at all
@@ -388,7 +391,13 @@ class StateStore:
         return sum(a.nbytes for a in arrays + [a for a in (self.table, self.offsets) if a is not None])
 
     def coverage(self) -> list[int]:
-        return np.bincount(self.rule.view, minlength=self.rules).tolist()
+        """Edges per rule. bincount widens its input to int64, 8 bytes per edge at once on the
+        whole array (more than the stored graph's own bytes/state): counted in slices."""
+        counts = np.zeros(self.rules, np.int64)
+        rule = self.rule.view
+        for lo in range(0, len(rule), COUNT):
+            counts += np.bincount(rule[lo:lo + COUNT], minlength=self.rules)
+        return counts.tolist()
 
     def path_to(self, i: int) -> list[int]:
         """Ids from the initial state to `i` along BFS parents (a shortest path)."""
