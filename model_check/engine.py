@@ -68,10 +68,11 @@ class Result:
     @property
     def bytes_per_state(self) -> float:
         """The summary line's bytes/state: the resident memory the check added at its peak
-        (VmHWM, reset at the check's start, minus VmRSS then: the interpreter, the imports and
-        the spec are not counted; the search, the stored graph and the property passes are)
-        over the states. Fixed costs (arrays' initial capacity, 4 KiB pages) dominate it on tiny
-        models, where `store_bytes_per_state` is the per-state cost."""
+        (storage.Meter: VmHWM, reset at the check's start, minus VmRSS then, minus the code pages
+        it faulted in: the interpreter, the imports, the spec and the model's compilation are not
+        counted; the search, the stored graph and the property passes are) over the states.
+        Fixed costs (arrays' initial capacity, 4 KiB pages) weigh most on tiny models, where
+        `store_bytes_per_state` is the per-state cost."""
         return self.peak_bytes / max(self.states, 1)
 
     @property
