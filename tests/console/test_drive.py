@@ -58,6 +58,14 @@ class Terminal:
                 except OSError:
                     return
 
+    def pump_until(self, marker: bytes, timeout: float) -> bool:
+        """Read until `marker` is on the screen: an event the simulation shows, not a wall time (a loaded
+        machine runs the paced simulation behind the clock)."""
+        end = time.monotonic() + timeout
+        while marker not in self.screen and time.monotonic() < end:
+            self.pump(0.05)
+        return marker in self.screen
+
     def type(self, keys: bytes) -> None:
         os.write(self.fd, keys)
 
@@ -163,10 +171,10 @@ def test_cli_console_pty_prints_the_device_and_takes_keys(tmp_path):
         first = proc.stdout.readline()
         assert first.startswith("RCP console on /dev/"), first
         term = Terminal(first.split()[3].rstrip(":"))
-        term.pump(3.0 / 3)                                             # simulated 3 s: after POST
+        assert term.pump_until(b"POST OPERATIONAL", timeout=30)         # the MCP's LCD line: POST is done (6.3)
         term.type(b"F")
         term.pump(0.5)
-        proc.wait(timeout=20)
+        proc.wait(timeout=60)
         term.close()
     finally:
         proc.kill()
