@@ -13,7 +13,21 @@ from arachnae_proto.network import NODES, POST, PostTable
 
 from behaviours.runtime import slaves_of
 
-_STATUS_REPLIES = (M.StatusAckOrder, M.StatusAckRange, M.StatusAckMmc)
+# the health replies to STATUS_REQ (spec reply_to; busy/free is no health status, and its senders are not asked)
+_STATUS_REPLIES = tuple(m for m in M.MESSAGES if m.REPLY_TO == M.StatusReq.NAME and m is not M.StatusAckBusy)
+
+
+def _inactive_codes() -> frozenset[tuple[type[M.Message], int]]:
+    """(reply, status code) pairs whose status names one of the POST's inactive statuses (seed 6.3)."""
+    out = set()
+    for cls in _STATUS_REPLIES:
+        enum = next((f.enum for f in cls.FIELDS if f.name == "status" and f.enum is not None), None)
+        if enum is not None:
+            out |= {(cls, int(enum[s])) for s in POST.inactive_statuses if s in enum.__members__}  # type: ignore[attr-defined]
+    return frozenset(out)
+
+
+_INACTIVE = _inactive_codes()
 
 
 @dataclass(frozen=True)
@@ -119,12 +133,6 @@ class PostMaster:
         self._post_waiting: list[int] = getattr(self, "_post_waiting", [])
         missing: list[int] = []
         retries = self.links[self.master_bus].timing.id_retries          # type: ignore[attr-defined]
-        inactive = set()
-        # seed 6.3: a status reply (spec reply_to STATUS_REQ) whose status names one of the POST's inactive statuses
-        for cls in (m for m in M.MESSAGES if m.REPLY_TO == M.StatusReq.NAME):
-            enum = next((f.enum for f in cls.FIELDS if f.name == "status" and f.enum is not None), None)
-            if enum is not None:
-                inactive |= {(cls, int(enum[s])) for s in POST.inactive_statuses if s in enum.__members__}  # type: ignore[attr-defined]
         steps = _PostSteps(self)
 
         def lost(a: int) -> None:
@@ -136,7 +144,7 @@ class PostMaster:
                 hook = getattr(self, "post_status", None)
                 if hook is not None:
                     hook(a, msg)                                           # the master keeps its slaves' status
-                if (type(msg), getattr(msg, "status", None)) in inactive:
+                if (type(msg), getattr(msg, "status", None)) in _INACTIVE:
                     lost(a)                                                # seed 6.3: declares itself inactive
 
             def on_ack(src: int, msg: M.Message, a: int = a) -> None:
