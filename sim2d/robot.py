@@ -4,8 +4,10 @@ Feet are kinematic points: a foot on the ground stays where it touched down
 (its anchor), and each physics step the body pose is the least-squares rigid
 transform that best keeps the stance feet on their anchors. The chassis is a
 pymunk shape, used only to detect contact with walls and tall obstacles: a
-move into one is refused (the feet slip). A swing foot that runs into a solid
-taller than itself stops there and its servos draw stall current (seed 6.1).
+move into one is refused (the feet slip). A foot in the air that runs into a
+solid taller than itself slides along its face and down it; where the face
+refuses more of the move than the foot makes, the servos draw stall current
+(seed 6.1: the LCP sees the leg blocked).
 
 Servos (seed 3.2.18): the JAC drives each one with a speed command
 (`set_joint_drive`, rad/s, limited by the servo's top speed) and closes the
@@ -29,6 +31,7 @@ from sim2d.world import BODY, OBSTACLE, WALL, World
 CONTACT_EPS = 0.002   # a foot within 2 mm of the ground touches it
 DEPTH_EPS = 1e-6      # a swing foot moving this much further into a solid's footprint is blocked
 LEG_REACH = 0.45      # body centre to the farthest foot, with margin
+SLIDE_SPEED = 0.03    # m/s: a foot pushing into a face that moves slower than this (along it or down) stalls
 
 
 @dataclass
@@ -212,9 +215,12 @@ class Robot:
                 ground = 0.0                      # fast path: nothing around can touch this foot
                 leg.over_pit = False
             else:
+                under = math.inf
                 if not was and moving and self.world.has_solids:
                     self._meet_solids(leg, old, old_foot, old_world, dt)
-                ground = self.world.ground_height(*leg.world)
+                    # a foot in the air that met an obstacle too tall to step onto is at its face, not on it
+                    under = max(old_foot[2] + CONTACT_EPS, p.step_limit)
+                ground = self.world.ground_height(*leg.world, under)
                 leg.over_pit = ground is None
             leg.contact = ground is not None and leg.foot[2] <= ground + CONTACT_EPS
             if leg.contact and not was:
@@ -248,8 +254,8 @@ class Robot:
         below). A foot the body carried into a footprint while it was in the air is not stuck there: only a move
         that takes it into the solid, or deeper, meets the face. There the foot slides along the face and down
         it: only the part of the move into the face is refused (issue 17/18: a foot hung on a wall's face found
-        no ground and read as a pit; a foot set down beside a wall stalled on its face). Where more of the move is
-        refused than made, the servos stall (seed 6.1: the swing is blocked, the LCP sees stall current)."""
+        no ground and read as a pit; a foot set down beside a wall stalled on its face). A foot that barely moves
+        (slower than SLIDE_SPEED) while it pushes stalls its servos (seed 6.1: the swing is blocked)."""
         fz = leg.foot[2]
         hip = to_world(self.pose, *self.p.hip(leg.index))
         solid = self.world.solid_at(*leg.world, hip)
@@ -262,7 +268,7 @@ class Robot:
         dx, dy = wx - ox, wy - oy
         into = min(0.0, dx * nx + dy * ny)                      # the push into the face (normal: out of it)
         along = (ox + dx - into * nx, oy + dy - into * ny)
-        made, refused = 0.0, abs(into)
+        made, refused = 0.0, math.dist(old_world, leg.world)
         for cx, cy in (along, old_world):                      # along the face (and down); else straight down
             if self.world.solid_at(cx, cy, hip).depth > before:
                 continue
@@ -281,7 +287,7 @@ class Robot:
             for j, a in zip(leg.joints, old):
                 j.angle, j.speed = a, 0.0
             leg.foot, leg.world = old_foot, old_world
-        if refused > made:
+        if refused > 0.0 and made < SLIDE_SPEED * dt:
             leg.blocked = True                                  # seed 6.1: the swing foot hits an obstacle
             self.events.blocked_legs += 1
 

@@ -84,14 +84,15 @@ class World:
         return best
 
     # --- ground -----------------------------------------------------------
-    def ground_height(self, x: float, y: float) -> float | None:
-        """Height of the ground a foot finds at (x, y); None over a pit (no ground)."""
+    def ground_height(self, x: float, y: float, under: float = math.inf) -> float | None:
+        """Height of the ground a foot finds at (x, y); None over a pit (no ground). Obstacles taller than `under`
+        do not count: a foot in the air below their top is at their side (on a face), not on them."""
         for pit in self.scenario.pits:
             if point_in_polygon(x, y, pit):
                 return None
         top = 0.0
         for ob in self.scenario.obstacles:
-            if point_in_polygon(x, y, ob.polygon):
+            if ob.height <= under and point_in_polygon(x, y, ob.polygon):
                 top = max(top, ob.height)
         return top
 
