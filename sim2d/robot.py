@@ -31,7 +31,8 @@ from sim2d.world import BODY, OBSTACLE, WALL, World
 CONTACT_EPS = 0.002   # a foot within 2 mm of the ground touches it
 DEPTH_EPS = 1e-6      # a swing foot moving this much further into a solid's footprint is blocked
 LEG_REACH = 0.45      # body centre to the farthest foot, with margin
-SLIDE_SPEED = 0.03    # m/s: a foot pushing into a face that moves slower than this (along it or down) stalls
+SLIDE_SPEED = 0.05    # m/s: a foot pushing into a face that moves slower than this (along it or down) stalls
+FACE_FRICTION = 0.5   # CHOICE: a foot slides along a face only if its move along it exceeds this x its push into it
 
 
 @dataclass
@@ -267,9 +268,11 @@ class Robot:
         (ox, oy), (wx, wy), (nx, ny) = old_world, leg.world, solid.normal
         dx, dy = wx - ox, wy - oy
         into = min(0.0, dx * nx + dy * ny)                      # the push into the face (normal: out of it)
-        along = (ox + dx - into * nx, oy + dy - into * ny)
+        tx, ty = dx - into * nx, dy - into * ny                 # ... and the part along it
         made, refused = 0.0, math.dist(old_world, leg.world)
-        for cx, cy in (along, old_world):                      # along the face (and down); else straight down
+        # friction: a foot meeting the face more squarely than the friction cone allows does not slide along it
+        slides = math.hypot(tx, ty) >= FACE_FRICTION * -into
+        for cx, cy in ([(ox + tx, oy + ty)] if slides else []) + [old_world]:   # along the face; straight down
             if self.world.solid_at(cx, cy, hip).depth > before:
                 continue
             q = ik(self.p, leg.index, *to_body(self.pose, cx, cy), fz)
