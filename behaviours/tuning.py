@@ -36,6 +36,7 @@ LCP_SETTLE_S = 0.3            # a carrying foot without sole contact this long (
 LCP_SET_DOWN_S = 0.15         # a stance target reaching a foot still in the air: it is set down within this time
 LCP_GROUND_SEARCH_M = 0.03    # CHOICE: a carrying foot without contact reaches this far down before "no ground"
 LCP_GROUND_SEARCH_M_S = 0.1   # CHOICE: how fast it reaches down (m/s)
+LCP_GROUND_REACHED_M = 0.01  # a foot without contact is over a pit only if its JACs put it this low (else: on a face)
 LCP_NO_GROUND_Z_M = 0.03      # seed 1.2.2: over a pit the foot hovers this high and carries no weight
 LCP_MIN_SPEED_DEG_S = 30.0    # slowest commanded joint speed: a joint catches up after a lost set point
 LCP_SPEED_MARGIN = 2.0        # commanded speed = this x the speed needed to arrive within one period
