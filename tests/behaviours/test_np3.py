@@ -31,7 +31,7 @@ def np3(spec, task: str = "forward") -> Rig:
 
 
 def data(role: str, value: int, kind: int = VALUE, channel: int = 0) -> M.Data:
-    return M.Data(address=ADDRESS_OF[role], kind=kind, channel=channel, value=value)
+    return M.Data(address=ADDRESS_OF[role], kind=kind, channel=channel, value=value, age=0)
 
 
 def moves(rig: Rig) -> list[tuple[float, MovCmd]]:
