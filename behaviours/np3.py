@@ -61,6 +61,38 @@ class Leg(NamedTuple):
     cmd: int
 
 
+class Echo(NamedTuple):
+    """An obstacle point of the local memory, in world (DR) terms: seen at body angle seen_deg, somewhere within
+    arc_m across the beam; `sonar`: a point of a sonar echo's cone (a later ping's free space may clear it)."""
+    t: float
+    x: float
+    y: float
+    seen_deg: float
+    arc_m: float
+    sonar: bool = False
+
+    def point(self) -> tuple[float, float, float, float]:
+        """What the network's `echoes` register holds per point."""
+        return self.x, self.y, self.seen_deg, self.arc_m
+
+
+class Ping(NamedTuple):
+    """A sonar ping as free space (issue 17): from (x, y) along world bearing `bearing` nothing nearer than
+    `reach` m across the cone (its nearest echo, or the sonar's range when none came back)."""
+    t: float
+    x: float
+    y: float
+    bearing: float
+    reach: float
+
+    def clears(self, px: float, py: float) -> bool:
+        """The point lies inside this ping's cone (tuning NP3_SONAR_CARVE_DEG) clearly nearer than its echo."""
+        dx, dy = px - self.x, py - self.y
+        off = (math.atan2(dy, dx) - self.bearing + math.pi) % (2 * math.pi) - math.pi
+        return (abs(off) <= math.radians(T.NP3_SONAR_CARVE_DEG)
+                and math.hypot(dx, dy) < self.reach - T.NP3_SONAR_CARVE_TOL_M)
+
+
 class DeadReckoning:
     """The pose the NP3 believes in: its own MOVE commands at the gait's measured speeds (CHOICE, no odometry).
     The last seconds of commands are kept, so the pose at an earlier time (a sonar ping's) is known too."""
@@ -146,7 +178,8 @@ class NP3(Runtime, Np3Skeleton):
         self.layers = np3_network(lambda: self.now, self.cfg.task, self.tuning)
         self.odo = DeadReckoning(T.NP3_DR_SPEED_M_S, math.radians(T.NP3_DR_TURN_DEG_S), T.NP3_DR_SIDE_M_S)
         self.geo = g
-        self.echoes: deque[tuple[float, ...]] = deque()   # (time, x, y, body angle seen at, arc half width m)
+        self.echoes: deque[Echo] = deque()
+        self.pings: deque[Ping] = deque()                 # the sonar's recent free space (issue 17)
         half = T.NP3_MAP_SIZE_M / 2
         self.map = TopoMap(OccupancyGrid(-half, -half, 2 * half, 2 * half, T.NP3_MAP_CELL_M),
                            robot_radius_m=g.body_width, place_spacing_m=1.0)
@@ -196,10 +229,10 @@ class NP3(Runtime, Np3Skeleton):
         self.map.visit(x, y)
         ahead = self.sonar_ahead
         fresh = ahead is not None and now - ahead[0] <= T.NP3_SONAR_FRESH_S and not self.sonar_ignored
-        while self.echoes and now - self.echoes[0][0] > T.NP3_ECHO_KEEP_S:
+        while self.echoes and now - self.echoes[0].t > T.NP3_ECHO_KEEP_S:
             self.echoes.popleft()
         self.layers.sense(pose=(x, y, th), sonar_ahead_m=ahead[1] if fresh else None,
-                          echoes=tuple(e[1:] for e in self.echoes))
+                          echoes=tuple(e.point() for e in self.echoes))
         if self.cfg.task in ("explore", "seek_light"):     # seeking light explores while it is dark
             self.mark_visited(x, y)
             goal = self.goal
@@ -231,7 +264,7 @@ class NP3(Runtime, Np3Skeleton):
     def refused(self, cmd: int, pose: tuple[float, float, float]) -> bool:
         """seed 5.1.2: the motion check. A command that would bring the body outline into the guard margin of
         an echo remembered at the dead-reckoned pose is refused; the guard reflex gets the safe alternative."""
-        pts = body_frame(tuple(e[1:] for e in self.echoes), pose)
+        pts = body_frame(tuple(e.point() for e in self.echoes), pose)
         if closing_in(pts, cmd, self.tuning) == 0.0:
             return False
         self.bump("veto", safe_instead(pts, cmd, self.tuning))
@@ -441,7 +474,7 @@ class NP3(Runtime, Np3Skeleton):
         ox, oy = self.at_body(bx, by, at)
         a = self.pose_at(at)[2] + math.radians(rel_deg)
         arc = d * math.sin(math.radians(cone_deg / 2))        # the echo may come from anywhere across the cone
-        self.echoes.append((self.now, ox + d * math.cos(a), oy + d * math.sin(a), rel_deg, arc))
+        self.echoes.append(Echo(self.now, ox + d * math.cos(a), oy + d * math.sin(a), rel_deg, arc))
 
     def refuse_slope(self) -> None:
         """A too steep slope is a boundary whatever the heading (3.2.14): the ground uphill of the body joins
@@ -469,11 +502,31 @@ class NP3(Runtime, Np3Skeleton):
         rel = (head_deg + 180) % 360 - 180
         if abs(rel) <= T.NP3_SONAR_AHEAD_DEG and d is not None:
             self.sonar_ahead = (pinged_at, d)
-        if d is not None and d < T.NP3_ECHO_NEAR_M:
-            self.echo(0.0, 0.0, rel, d, T.NP3_SONAR_BEAM_DEG, at=pinged_at)
+        self.sonar_memory(Ping(self.now, x, y, th + math.radians(rel), _Q["USRC"].phys(_Q["USRC"].hi) if d is None
+                               else d), rel)
         half, n = T.NP3_SONAR_BEAM_DEG / 2, 5
         cone = [Reading(x, y, math.degrees(th), head_deg - half + 2 * half * k / (n - 1), d) for k in range(n)]
         self.map.add(cone)
+
+    def sonar_memory(self, ping: Ping, rel_deg: float) -> None:
+        """Issue 17: a sonar echo is the nearest reflector anywhere across the beam, so it joins the local memory
+        as points spread over the cone; what a ping shows free (nearer than its echo) clears the points of
+        other pings there. In a corridor the cone's inner edge lies inside the legs' way, and only the
+        pings from further on, whose cones pass over that spot, show it free."""
+        while self.pings and ping.t - self.pings[0].t > T.NP3_SONAR_CARVE_S:
+            self.pings.popleft()
+        if any(e.sonar and ping.clears(e.x, e.y) for e in self.echoes):
+            self.echoes = deque(e for e in self.echoes if not (e.sonar and ping.clears(e.x, e.y)))
+        if ping.reach < T.NP3_ECHO_NEAR_M:
+            n = T.NP3_SONAR_CONE_POINTS
+            half = math.radians(T.NP3_SONAR_BEAM_DEG / 2)
+            arc = ping.reach * math.sin(half / (n - 1))            # each point: its share of the cone
+            for k in range(n):
+                off = -half + 2 * half * k / (n - 1)
+                px, py = ping.x + ping.reach * math.cos(ping.bearing + off), ping.y + ping.reach * math.sin(ping.bearing + off)
+                if not any(p.clears(px, py) for p in self.pings):
+                    self.echoes.append(Echo(self.now, px, py, rel_deg + math.degrees(off), arc, sonar=True))
+        self.pings.append(ping)
 
     # --- debug port --------------------------------------------------------------------------------
     def debug_metrics(self) -> Np3Debug:

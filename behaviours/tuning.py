@@ -125,7 +125,11 @@ NP3_DR_TURN_DEG_S = 22.5      # ... and turn rate on the spot (nominal 25 deg/s)
 NP3_POSE_HISTORY_S = 3.0      # dead reckoning: commands kept this long, for the pose at a record's age (issue 17;
                               # the age field reaches 2.55 s)
 NP3_ECHO_KEEP_S = 10.0        # local memory: sonar / IR / whisker echoes at the dead-reckoned pose kept this long
-NP3_ECHO_NEAR_M = 1.5         # ... sonar echoes nearer than this only (the map keeps the rest)
+NP3_ECHO_NEAR_M = 1.5         # ... sonar echoes nearer than this only (the map keeps the rest), each as
+NP3_SONAR_CONE_POINTS = 5     # ... this many points across the beam (the reflector is somewhere on that arc);
+NP3_SONAR_CARVE_S = 5.0       # ... a ping of the last 5 s clears the points of others inside its cone
+NP3_SONAR_CARVE_DEG = 6.0     # ... (this far either side of its axis, inside the beam's 7.5 deg edge) ...
+NP3_SONAR_CARVE_TOL_M = 0.06  # ... and nearer than its own echo by this much (noise 2 cm, one step 4 cm; issue 17)
 NP3_BODY_FRONT_M = 0.15       # sensor mounts as the NP3 knows them: IR and whiskers at the body's front (CHOICE),
 NP3_IR_BEAM_DEG = 15.0        # ... the IR side beams at +-15 deg (seed 3.2.13),
 NP3_WHISKER_DEG = 25.0        # ... the whiskers 25 deg outward (CHOICE) ...
