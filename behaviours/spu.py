@@ -68,7 +68,7 @@ class SonarScan:
     the heading, and every SPU_SCAN_ROUND_EVERY-th angle one step round the rest of the circle, for the map."""
 
     def __init__(self) -> None:
-        edge = max(abs(a) for a in T.SPU_SCAN_AHEAD_DEG)
+        edge = max((abs(a) for a in T.SPU_SCAN_AHEAD_DEG), default=0)
         self.ahead = [a % 360 for a in T.SPU_SCAN_AHEAD_DEG]
         self.round = list(range(edge + T.SPU_SCAN_ROUND_STEP_DEG, 360 - edge, T.SPU_SCAN_ROUND_STEP_DEG))
         self.steps = self.ahead_i = self.round_i = 0
@@ -132,6 +132,7 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
         self.last_fwd: dict[tuple[str, int], tuple[float, int]] = {}
         self.last_record: Record | None = None
         self.scan = SonarScan()
+        self.free_run: set[str] = set()
         self.pinged_at: float | None = None      # when the last DO_MEASURE reached the USRC (its echo heard)
         self.requested_at: float | None = None
         self.posting = False
@@ -155,6 +156,9 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
     def post_done(self, missing: list[int]) -> None:
         self.posting = False
         self.live = [r for r, a in self.sensors.items() if a not in missing]
+        if "USRC" in self.live and not T.SPU_SCAN_AHEAD_DEG:   # seed 3.2.11: no scan of its own: the sonar
+            self.free_run.add("USRC")                          # scans its circle and announces each sector
+            self.request(self.sensors["USRC"], M.FreeRun())
         # seed 3.2.13-3.2.17: the SPU sets up the alarm limits of every sensor present
         for role, msg, limits in alarm_setup():
             if role in self.live:
@@ -178,7 +182,7 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
                          lambda s, m, role=role: (self.set_status(role, m.status), self.answered(role), self.poll()),
                          lambda role=role: (self.missed(role), self.poll()))
             return
-        cycle = [r for r in T.SPU_CYCLE if r in self.live]
+        cycle = [r for r in T.SPU_CYCLE if r in self.live and r not in self.free_run]
         if not cycle:
             self.hw.after(T.SPU_STATUS_EVERY_S, self.poll)
             return
@@ -228,6 +232,13 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
     def on_data_rdy(self, src: int, msg: M.DataRdy) -> None:
         role = NODES[src].role
         if role not in XMIT_DATA_OF or role not in self.live:
+            return
+        if role in self.free_run:                  # a free-running sonar's sector: pinged some time before
+            if self.status.get(role, _IN_ORDER) != _IN_ORDER:
+                self.counts["ignored"] += 1       # seed 6.2: an untrustworthy sensor's data is ignored
+                return
+            self.request(src, M.XmitData(), (XMIT_DATA_OF[role],), lambda s, m, role=role: self.got(role, m, False),
+                         lambda role=role: self.missed(role), urgent=True)
             return
         event = role != "TPSC"                     # anything else announces an alarm or a status change
         if role in RANGE:                          # its status first: is the data to be trusted (6.2)

@@ -212,3 +212,14 @@ def test_asked_for_its_id_again_after_reporting_the_spu_runs_a_new_post(spec):
     assert rig.node.debug_metrics()["posts"] == 2
     polls_after = [t for t, f in rig.frames(M.XmitData) if t > 7.0]
     assert polls_after                                      # polling resumed after the new POST
+
+
+def test_without_a_scan_of_its_own_the_sonar_free_runs_and_announces_its_sectors(spec, monkeypatch):
+    """seed 3.2.11: SPU_SCAN_AHEAD_DEG empty: FREE_RUN, the sonar is fetched when it announces, never polled."""
+    monkeypatch.setattr(T, "SPU_SCAN_AHEAD_DEG", ())
+    rig, _ = spu(spec)
+    assert [f.dst for _, f in rig.frames(M.FreeRun)] == [A["USRC"]]
+    assert A["USRC"] not in {f.dst for _, f in rig.frames(M.XmitData)} and rig.frames(M.HeadSetAbs) == []
+    rig.inject(3.0, A["USRC"], M.DataRdy())
+    rig.run(3.5)
+    assert len(records(rig, "USRC", int(RecordKind.VALUE))) == 1
