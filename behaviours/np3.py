@@ -510,8 +510,8 @@ class NP3(Runtime, Np3Skeleton):
 
     def sonar_memory(self, ping: Ping, rel_deg: float) -> None:
         """Issue 17: a sonar echo is the nearest reflector anywhere across the beam, so it joins the local memory
-        as points spread over the cone; what a ping shows free (nearer than its echo) clears the points of
-        other pings there. In a corridor the cone's inner edge lies inside the legs' way, and only the
+        as points spread over the cone (each with the beam's whole arc: clear_ahead counts only echoes surely
+        in the way); what a ping shows free (nearer than its echo) clears the points of other pings there. In a corridor the cone's inner edge lies inside the legs' way, and only the
         pings from further on, whose cones pass over that spot, show it free."""
         while self.pings and ping.t - self.pings[0].t > T.NP3_SONAR_CARVE_S:
             self.pings.popleft()
@@ -520,7 +520,7 @@ class NP3(Runtime, Np3Skeleton):
         if ping.reach < T.NP3_ECHO_NEAR_M:
             n = T.NP3_SONAR_CONE_POINTS
             half = math.radians(T.NP3_SONAR_BEAM_DEG / 2)
-            arc = ping.reach * math.sin(half / (n - 1))            # each point: its share of the cone
+            arc = ping.reach * math.sin(half)     # each point: the reflector may lie anywhere across the beam
             for k in range(n):
                 off = -half + 2 * half * k / (n - 1)
                 px, py = ping.x + ping.reach * math.cos(ping.bearing + off), ping.y + ping.reach * math.sin(ping.bearing + off)
