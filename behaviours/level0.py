@@ -31,6 +31,7 @@ from behaviours.runtime import Runtime
 from behaviours.speech import Speaker, write_wav
 from behaviours.rcp_keys import KeyDecoder, label_for_key, message_for_key
 from behaviours.rcp_screen import Screen
+from behaviours.units import age_byte
 
 _MCP, _NP3 = ADDRESS_OF["MCP"], ADDRESS_OF["NP3"]
 _REDRAW = "\x0c"          # Ctrl-L: the terminal asks for the whole picture again
@@ -156,7 +157,7 @@ class APU_SDF(_Records, Runtime, ApuSdfSkeleton):
         value = max(0, min(255, int(round(level))))          # dB, clamped to the byte
         self.hw.note("sound_direction", direction_deg=channel, level_db=value)
         self.queue_record(M.XmitRecord(target=_NP3, source=self.address, kind=int(RecordKind.VALUE),
-                                       channel=channel, value=value))
+                                       channel=channel, value=value, age=age_byte(T.APU_PROCESS_S)))
 
     def status_ack(self) -> M.Message:
         """seed 3.2.7: BUSY while an event is processed and its record waits for the bus."""

@@ -113,7 +113,8 @@ class MCP(PostMaster, Runtime, McpSkeleton):
         self.request(BROADCAST, M.Init())
         for (source, channel), value in sorted(self.faults.items()):
             # the NP3 starts afresh: what is known to be broken still is (6.2)
-            self.request(ADDRESS_OF["NP3"], M.Data(address=source, kind=_STATUS, channel=channel, value=value))
+            self.request(ADDRESS_OF["NP3"], M.Data(address=source, kind=_STATUS, channel=channel, value=value,
+                                                          age=0))   # the state now
         if self.present("MMC") and not self.polling_mmc:
             self.polling_mmc = True
             self.every(T.MCP_MMC_POLL_S, self.poll_mmc)
@@ -176,8 +177,9 @@ class MCP(PostMaster, Runtime, McpSkeleton):
         if self._scheduled(src, msg) and msg.target == ADDRESS_OF["NP3"]:
             self.counts["records"] += 1
             self.reflex(msg)
-            self.request(msg.target, M.Data(address=msg.source, kind=msg.kind, channel=msg.channel, value=msg.value),
-                         priority=PRIORITY_RELAY)
+            # the age passes on: the relay goes before the next grant, a frame at most later (issue 17)
+            self.request(msg.target, M.Data(address=msg.source, kind=msg.kind, channel=msg.channel, value=msg.value,
+                                            age=msg.age), priority=PRIORITY_RELAY)
             self.supervise(msg)
 
     def reflex(self, rec: M.XmitRecord) -> None:
@@ -218,7 +220,7 @@ class MCP(PostMaster, Runtime, McpSkeleton):
         self.faults = {k: v for k, v in self.faults.items() if k[0] != mmc}
         if ack.error != _NO_ERROR:
             self.faults[(mmc, ack.leg)] = ack.error
-        self.request(ADDRESS_OF["NP3"], M.Data(address=mmc, kind=_STATUS, channel=ack.leg, value=ack.error))
+        self.request(ADDRESS_OF["NP3"], M.Data(address=mmc, kind=_STATUS, channel=ack.leg, value=ack.error, age=0))
         if ack.error != _NO_ERROR:
             name = MmcError(ack.error).name.removeprefix("LEG_").replace("_", " ")
             self.tell("operator", lcd_lines(f"LEG {ack.leg}", name), _SAY_LEG_ERROR.get(ack.error))

@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 from collections import deque
 from pathlib import Path
-from typing import Any, TypedDict
+from typing import Any, NamedTuple, TypedDict
 
 from arachnae_proto import messages as M
 from arachnae_proto.enums import MmcError, MovCmd, RangeStatus, RecordKind, TpscContact
@@ -33,7 +33,7 @@ from behaviours.np3_layers import (AVOIDANCE, REFLEXES, Tuning, body_frame, clos
                                    steepness_deg, uphill)
 from behaviours.runtime import Runtime
 from behaviours.topomap import OCCUPIED, OccupancyGrid, Reading, TopoMap, ray_cells
-from behaviours.units import XMIT_DATA_OF, Quantizer, from_record_byte, quantizer
+from behaviours.units import RECORD_AGE, XMIT_DATA_OF, Quantizer, from_record_byte, quantizer
 
 _VALUE, _ALARM, _STATUS = int(RecordKind.VALUE), int(RecordKind.ALARM), int(RecordKind.STATUS)
 _IR_BAD = {int(RangeStatus.UNRELIABLE), int(RangeStatus.OUT_OF_ORDER)}
@@ -52,8 +52,50 @@ def decode(role: str, value: int) -> float:
     return q.phys(from_record_byte(value, q.lo < 0))
 
 
+class Leg(NamedTuple):
+    """A stretch of dead reckoning: from time t at pose (x, y, th) the robot did cmd."""
+    t: float
+    x: float
+    y: float
+    th: float
+    cmd: int
+
+
+class Echo(NamedTuple):
+    """An obstacle point of the local memory, in world (DR) terms: seen at body angle seen_deg, somewhere within
+    arc_m across the beam; `sonar`: a point of a sonar echo's cone (a later ping's free space may clear it)."""
+    t: float
+    x: float
+    y: float
+    seen_deg: float
+    arc_m: float
+    sonar: bool = False
+
+    def point(self) -> tuple[float, float, float, float]:
+        """What the network's `echoes` register holds per point."""
+        return self.x, self.y, self.seen_deg, self.arc_m
+
+
+class Ping(NamedTuple):
+    """A sonar ping as free space (issue 17): from (x, y) along world bearing `bearing` nothing nearer than
+    `reach` m across the cone (its nearest echo, or the sonar's range when none came back)."""
+    t: float
+    x: float
+    y: float
+    bearing: float
+    reach: float
+
+    def clears(self, px: float, py: float) -> bool:
+        """The point lies inside this ping's cone (tuning NP3_SONAR_CARVE_DEG) clearly nearer than its echo."""
+        dx, dy = px - self.x, py - self.y
+        off = (math.atan2(dy, dx) - self.bearing + math.pi) % (2 * math.pi) - math.pi
+        return (abs(off) <= math.radians(T.NP3_SONAR_CARVE_DEG)
+                and math.hypot(dx, dy) < self.reach - T.NP3_SONAR_CARVE_TOL_M)
+
+
 class DeadReckoning:
-    """The pose the NP3 believes in: its own MOVE commands at the gait's measured speeds (CHOICE, no odometry)."""
+    """The pose the NP3 believes in: its own MOVE commands at the gait's measured speeds (CHOICE, no odometry).
+    The last seconds of commands are kept, so the pose at an earlier time (a sonar ping's) is known too."""
 
     def __init__(self, speed_m_s: float, turn_rad_s: float, side_m_s: float | None = None) -> None:
         self.x = self.y = self.th = 0.0
@@ -61,22 +103,39 @@ class DeadReckoning:
         self.side = speed_m_s if side_m_s is None else side_m_s
         self.cmd = _STOP
         self.t: float | None = None
+        self.legs: deque[Leg] = deque()
+
+    def moved(self, x: float, y: float, th: float, cmd: int, dt: float) -> tuple[float, float, float]:
+        """The pose after doing `cmd` for dt seconds from (x, y, th)."""
+        v = self.speed if cmd == _FORWARD else -self.speed if cmd == _BACKWARD else 0.0
+        u = self.side if cmd == _SIDE_L else -self.side if cmd == _SIDE_R else 0.0
+        w = self.turn if cmd == _LEFT else -self.turn if cmd == _RIGHT else 0.0
+        a = th + w * dt / 2
+        return (x + (v * math.cos(a) - u * math.sin(a)) * dt, y + (v * math.sin(a) + u * math.cos(a)) * dt,
+                (th + w * dt + math.pi) % (2 * math.pi) - math.pi)
 
     def advance(self, now: float) -> None:
         dt = 0.0 if self.t is None else max(0.0, now - self.t)
         self.t = now
-        v = self.speed if self.cmd == _FORWARD else -self.speed if self.cmd == _BACKWARD else 0.0
-        u = self.side if self.cmd == _SIDE_L else -self.side if self.cmd == _SIDE_R else 0.0
-        w = self.turn if self.cmd == _LEFT else -self.turn if self.cmd == _RIGHT else 0.0
-        a = self.th + w * dt / 2
-        self.x += (v * math.cos(a) - u * math.sin(a)) * dt
-        self.y += (v * math.sin(a) + u * math.cos(a)) * dt
-        self.th = (self.th + w * dt + math.pi) % (2 * math.pi) - math.pi
+        self.x, self.y, self.th = self.moved(self.x, self.y, self.th, self.cmd, dt)
 
     def command(self, now: float, cmd: int) -> None:
         self.advance(now)
         if cmd < int(MovCmd.TRIPOD):            # a direction; 7..9 only change the gait
             self.cmd = cmd
+            self.legs.append(Leg(now, self.x, self.y, self.th, cmd))
+            while len(self.legs) > 1 and now - self.legs[1].t > T.NP3_POSE_HISTORY_S:
+                self.legs.popleft()
+
+    def pose_at(self, t: float) -> tuple[float, float, float]:
+        """The pose at time t (not after the last advance): on the command leg running then (issue 17)."""
+        if self.t is None or t >= self.t:
+            return self.pose
+        leg = next((g for g in reversed(self.legs) if g.t <= t), None)
+        if leg is None:                         # before the history (or before any command): its start
+            first = self.legs[0] if self.legs else None
+            return (first.x, first.y, first.th) if first else self.pose
+        return self.moved(leg.x, leg.y, leg.th, leg.cmd, t - leg.t)
 
     @property
     def pose(self) -> tuple[float, float, float]:
@@ -119,7 +178,8 @@ class NP3(Runtime, Np3Skeleton):
         self.layers = np3_network(lambda: self.now, self.cfg.task, self.tuning)
         self.odo = DeadReckoning(T.NP3_DR_SPEED_M_S, math.radians(T.NP3_DR_TURN_DEG_S), T.NP3_DR_SIDE_M_S)
         self.geo = g
-        self.echoes: deque[tuple[float, ...]] = deque()   # (time, x, y, body angle seen at, arc half width m)
+        self.echoes: deque[Echo] = deque()
+        self.pings: deque[Ping] = deque()                 # the sonar's recent free space (issue 17)
         half = T.NP3_MAP_SIZE_M / 2
         self.map = TopoMap(OccupancyGrid(-half, -half, 2 * half, 2 * half, T.NP3_MAP_CELL_M),
                            robot_radius_m=g.body_width, place_spacing_m=1.0)
@@ -169,10 +229,10 @@ class NP3(Runtime, Np3Skeleton):
         self.map.visit(x, y)
         ahead = self.sonar_ahead
         fresh = ahead is not None and now - ahead[0] <= T.NP3_SONAR_FRESH_S and not self.sonar_ignored
-        while self.echoes and now - self.echoes[0][0] > T.NP3_ECHO_KEEP_S:
+        while self.echoes and now - self.echoes[0].t > T.NP3_ECHO_KEEP_S:
             self.echoes.popleft()
         self.layers.sense(pose=(x, y, th), sonar_ahead_m=ahead[1] if fresh else None,
-                          echoes=tuple(e[1:] for e in self.echoes))
+                          echoes=tuple(e.point() for e in self.echoes))
         if self.cfg.task in ("explore", "seek_light"):     # seeking light explores while it is dark
             self.mark_visited(x, y)
             goal = self.goal
@@ -204,7 +264,7 @@ class NP3(Runtime, Np3Skeleton):
     def refused(self, cmd: int, pose: tuple[float, float, float]) -> bool:
         """seed 5.1.2: the motion check. A command that would bring the body outline into the guard margin of
         an echo remembered at the dead-reckoned pose is refused; the guard reflex gets the safe alternative."""
-        pts = body_frame(tuple(e[1:] for e in self.echoes), pose)
+        pts = body_frame(tuple(e.point() for e in self.echoes), pose)
         if closing_in(pts, cmd, self.tuning) == 0.0:
             return False
         self.bump("veto", safe_instead(pts, cmd, self.tuning))
@@ -319,6 +379,7 @@ class NP3(Runtime, Np3Skeleton):
             return
         self.records += 1
         role, kind, ch, v = NODES[msg.address].role, msg.kind, msg.channel, msg.value
+        measured_at = self.now - RECORD_AGE.phys(msg.age)          # issue 17: when the source measured it
         urgent = True
         if role == "MMC" and kind == _STATUS:
             self.mmc_status(ch, v)
@@ -336,7 +397,7 @@ class NP3(Runtime, Np3Skeleton):
         elif role == "IRRC" and 0 <= ch < 3:                            # seed 3.2.13: beam 0 left, 1 centre, 2 right
             self.ir[ch] = None if v >= _Q["IRRC"].hi else decode(role, v) / 100
             if self.ir[ch] is not None:
-                self.echo(T.NP3_BODY_FRONT_M, 0.0, (1 - ch) * T.NP3_IR_BEAM_DEG, self.ir[ch])
+                self.echo(T.NP3_BODY_FRONT_M, 0.0, (1 - ch) * T.NP3_IR_BEAM_DEG, self.ir[ch], at=measured_at)
             self.layers.sense(ir=tuple(self.ir))
         elif role == "ISC" and ch in (0, 1):                            # seed 3.2.14: axis 0 / 1
             self.tilt[ch] = decode(role, v)
@@ -351,7 +412,7 @@ class NP3(Runtime, Np3Skeleton):
             self.light(decode(role, v))
             urgent = False
         elif role == "USRC":
-            self.sonar(ch, v)
+            self.sonar(ch, v, measured_at)
             urgent = False
         elif role == "APU_SDF" and kind == _VALUE:                      # seed 3.2.7: sound direction, body frame
             self.bump("sound", ch)
@@ -395,19 +456,25 @@ class NP3(Runtime, Np3Skeleton):
             if bad:
                 self.sonar_ahead = None
 
-    def at_body(self, bx: float, by: float) -> tuple[float, float]:
-        """A body-frame point (x forward, y left) in the world frame of the dead-reckoned pose now."""
+    def pose_at(self, t: float | None) -> tuple[float, float, float]:
+        """The dead-reckoned pose now (t None) or at the earlier time t (a record's measurement, issue 17)."""
         self.odo.advance(self.now)
-        x, y, th = self.odo.pose
+        return self.odo.pose if t is None else self.odo.pose_at(t)
+
+    def at_body(self, bx: float, by: float, at: float | None = None) -> tuple[float, float]:
+        """A body-frame point (x forward, y left) in the world frame of the dead-reckoned pose now (or at `at`)."""
+        x, y, th = self.pose_at(at)
         return x + bx * math.cos(th) - by * math.sin(th), y + bx * math.sin(th) + by * math.cos(th)
 
-    def echo(self, bx: float, by: float, rel_deg: float, d: float, cone_deg: float = 0.0) -> None:
+    def echo(self, bx: float, by: float, rel_deg: float, d: float, cone_deg: float = 0.0,
+             at: float | None = None) -> None:
         """An obstacle point seen from (bx, by) in the body frame, d m away at rel_deg, kept in world (DR) terms
-        with the angle it was seen at: the local memory the tasks steer by (sonar sector minima come ~8 s apart)."""
-        ox, oy = self.at_body(bx, by)
-        a = self.odo.th + math.radians(rel_deg)
+        with the angle it was seen at: the local memory the tasks steer by. `at`: when it was measured; the
+        point is placed from the pose the robot had then (issue 17: a sonar echo reaches the NP3 late)."""
+        ox, oy = self.at_body(bx, by, at)
+        a = self.pose_at(at)[2] + math.radians(rel_deg)
         arc = d * math.sin(math.radians(cone_deg / 2))        # the echo may come from anywhere across the cone
-        self.echoes.append((self.now, ox + d * math.cos(a), oy + d * math.sin(a), rel_deg, arc))
+        self.echoes.append(Echo(self.now, ox + d * math.cos(a), oy + d * math.sin(a), rel_deg, arc))
 
     def refuse_slope(self) -> None:
         """A too steep slope is a boundary whatever the heading (3.2.14): the ground uphill of the body joins
@@ -425,21 +492,41 @@ class NP3(Runtime, Np3Skeleton):
         self.seq["light"] += 1
         self.layers.sense(light=(self.seq["light"], x, y, math.log10(max(lux, 1e-3))))
 
-    def sonar(self, head_deg: int, raw: int) -> None:
-        """seed 3.3.2: an echo (channel = head angle, body frame) into the map at the dead-reckoned pose."""
+    def sonar(self, head_deg: int, raw: int, pinged_at: float) -> None:
+        """seed 3.3.2: an echo (channel = head angle, body frame) into the map at the dead-reckoned pose of its
+        ping (issue 17: placed at the pose of arrival, a turning robot put walls into its own path)."""
         if self.sonar_ignored:
             return
         d = None if raw >= _Q["USRC"].hi else decode("USRC", raw)
-        self.odo.advance(self.now)
-        x, y, th = self.odo.pose
+        x, y, th = self.pose_at(pinged_at)
         rel = (head_deg + 180) % 360 - 180
         if abs(rel) <= T.NP3_SONAR_AHEAD_DEG and d is not None:
-            self.sonar_ahead = (self.now, d)
-        if d is not None and d < T.NP3_ECHO_NEAR_M:
-            self.echo(0.0, 0.0, rel, d, T.NP3_SONAR_BEAM_DEG)
+            self.sonar_ahead = (pinged_at, d)
+        self.sonar_memory(Ping(self.now, x, y, th + math.radians(rel), _Q["USRC"].phys(_Q["USRC"].hi) if d is None
+                               else d), rel)
         half, n = T.NP3_SONAR_BEAM_DEG / 2, 5
         cone = [Reading(x, y, math.degrees(th), head_deg - half + 2 * half * k / (n - 1), d) for k in range(n)]
         self.map.add(cone)
+
+    def sonar_memory(self, ping: Ping, rel_deg: float) -> None:
+        """Issue 17: a sonar echo is the nearest reflector anywhere across the beam, so it joins the local memory
+        as points spread over the cone (each with the beam's whole arc: clear_ahead counts only echoes surely
+        in the way); what a ping shows free (nearer than its echo) clears the points of other pings there. In a corridor the cone's inner edge lies inside the legs' way, and only the
+        pings from further on, whose cones pass over that spot, show it free."""
+        while self.pings and ping.t - self.pings[0].t > T.NP3_SONAR_CARVE_S:
+            self.pings.popleft()
+        if any(e.sonar and ping.clears(e.x, e.y) for e in self.echoes):
+            self.echoes = deque(e for e in self.echoes if not (e.sonar and ping.clears(e.x, e.y)))
+        if ping.reach < T.NP3_ECHO_NEAR_M:
+            n = T.NP3_SONAR_CONE_POINTS
+            half = math.radians(T.NP3_SONAR_BEAM_DEG / 2)
+            arc = ping.reach * math.sin(half)     # each point: the reflector may lie anywhere across the beam
+            for k in range(n):
+                off = -half + 2 * half * k / (n - 1)
+                px, py = ping.x + ping.reach * math.cos(ping.bearing + off), ping.y + ping.reach * math.sin(ping.bearing + off)
+                if not any(p.clears(px, py) for p in self.pings):
+                    self.echoes.append(Echo(self.now, px, py, rel_deg + math.degrees(off), arc, sonar=True))
+        self.pings.append(ping)
 
     # --- debug port --------------------------------------------------------------------------------
     def debug_metrics(self) -> Np3Debug:

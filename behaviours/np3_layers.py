@@ -263,22 +263,14 @@ def body_gap(px: float, py: float, t: Tuning) -> float:
 def closing_in(points: list[Point], cmd: Any, t: Tuning) -> float:
     """How far (m) the body's outline comes into the guard margin of a point it moves towards, following
     `cmd` for the guard horizon (0: the move is safe). Only points the motion brings closer count: a body
-    already near a wall may still move away from it, and the echo's arc across a sonar beam counts as solid."""
+    already near a wall may still move away from it. A sonar echo comes as points across its beam, those a
+    later ping showed free already gone (behaviours.np3, issue 17), so each point counts as it lies."""
     vx, vy, w = velocity(cmd, t)
     if vx == vy == w == 0.0:
         return 0.0
     reach = math.hypot(t.body_half_length_m, t.body_half_width_m) + t.guard_margin_m \
         + t.guard_horizon_s * max(abs(vx), abs(vy), abs(w) * t.body_half_length_m)
-    near: list[tuple[float, float]] = []
-    for bx, by, _seen, arc in points:
-        d = math.hypot(bx, by)
-        if d - arc > reach:
-            continue
-        if arc > 0 and d > 0:                       # the ends and middle of the arc across the beam
-            ux, uy = -by / d, bx / d
-            near += [(bx + k * arc * ux, by + k * arc * uy) for k in (-1.0, 0.0, 1.0)]
-        else:
-            near.append((bx, by))
+    near = [(bx, by) for bx, by, _seen, _arc in points if math.hypot(bx, by) <= reach]
     worst = 0.0
     steps = 10
     for px, py in near:

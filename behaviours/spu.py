@@ -1,21 +1,24 @@
 """SPU (seed 3.2.5): master of the sensor bus; sets the sensors up, polls them and forwards to the NP3.
 
-After its POST the SPU sets up every sensor's SET_ALARM limit (tuning) and
-puts the USRC into FREE_RUN. Then it polls the other sensors round-robin
-(tuning.SPU_CYCLE, the IRRC every second poll because close range matters
-most, 5.2) and asks the range sensors for their status in turn. A DATA_RDY
-is served before the next poll: from the free-running USRC it announces a
-sector's nearest echo, from the TPSC a contact, from any other sensor an
-alarm (or, from the IRRC, a status change). What the NP3 needs travels as
-XMIT_RECORDs through the MCP (3.2.2): VALUE records (rate-limited per
-sensor channel), ALARM records for a crossed limit, STATUS records when a
-sensor's status changes. A sensor that stops answering counts as
-OUT_OF_ORDER; a range sensor that is not IN_ORDER is not trusted and its data
-is ignored (6.2).
+After its POST the SPU sets up every sensor's SET_ALARM limit (tuning).
+Then it polls the sensors round-robin (tuning.SPU_CYCLE, the IRRC every
+second poll because close range matters most, 5.2) and asks the range
+sensors for their status in turn. The sonar's poll is one angle of a scan
+the SPU drives (HEAD_SET_ABS, DO_MEASURE, XMIT_DATA; 3.2.11): a sweep ahead
+of the heading with, every few angles, one of the rest of the circle for the
+map. Unlike the USRC's free-running circle, whose sector minima came up to a
+sector's scan late and at an unknown time, the SPU knows when each echo was
+pinged (issue 17). A DATA_RDY is served before the next poll: from the TPSC
+a contact, from any other sensor an alarm or a status change. What the NP3
+needs travels as XMIT_RECORDs through the MCP (3.2.2): VALUE records
+(rate-limited per sensor channel), ALARM records for a crossed limit, STATUS
+records when a sensor's status changes, each with its age (how long ago it
+was measured). A sensor that stops answering counts as OUT_OF_ORDER; a range
+sensor that is not IN_ORDER is not trusted and its data is ignored (6.2).
 """
 from __future__ import annotations
 
-from typing import Any, TypedDict
+from typing import Any, NamedTuple, TypedDict
 
 from arachnae_proto import messages as M
 from arachnae_proto.enums import IscAxis, RangeStatus, RecordKind
@@ -26,7 +29,7 @@ from behaviours import tuning as T
 from behaviours.post import PostMaster
 from behaviours.runtime import PRIORITY_REFLEX, Runtime, slaves_of
 from behaviours.sensors import ABOVE, BELOW, BEYOND, AlarmLimit, limit_in
-from behaviours.units import XMIT_DATA_OF, quantizer, record_byte
+from behaviours.units import XMIT_DATA_OF, age_byte, quantizer, record_byte
 
 # each sensor role's STATUS_ACK layout; the range sensors are the ones with UNRELIABLE (3.2.11, 3.2.13)
 STATUS_OF = {role: cls for cls in (M.StatusAckRange, M.StatusAckOrder) for role in cls.SENDERS}
@@ -49,6 +52,34 @@ def channels(role: str, msg: Any) -> dict[int, int]:
         return {msg.channel: msg.temperature}
     (only,) = XMIT_DATA_OF[role].FIELDS           # TPSC, LSC, PSC: a record of one field
     return {0: getattr(msg, only.name)}
+
+
+class Record(NamedTuple):
+    """A record waiting for the MCP's grant: what XMIT_RECORD carries, and when its value was measured."""
+    source: int
+    kind: int
+    channel: int
+    value: int
+    measured_at: float
+
+
+class SonarScan:
+    """The angles (body frame, 0..359) of the sonar scan the SPU drives, one per poll (issue 17): the sweep ahead of
+    the heading, and every SPU_SCAN_ROUND_EVERY-th angle one step round the rest of the circle, for the map."""
+
+    def __init__(self) -> None:
+        edge = max((abs(a) for a in T.SPU_SCAN_AHEAD_DEG), default=0)
+        self.ahead = [a % 360 for a in T.SPU_SCAN_AHEAD_DEG]
+        self.round = list(range(edge + T.SPU_SCAN_ROUND_STEP_DEG, 360 - edge, T.SPU_SCAN_ROUND_STEP_DEG))
+        self.steps = self.ahead_i = self.round_i = 0
+
+    def next(self) -> int:
+        self.steps += 1
+        if self.round and self.steps % T.SPU_SCAN_ROUND_EVERY == 0:
+            self.round_i += 1
+            return self.round[(self.round_i - 1) % len(self.round)]
+        self.ahead_i += 1
+        return self.ahead[(self.ahead_i - 1) % len(self.ahead)]
 
 
 def alarm_setup() -> list[tuple[str, M.Message, list[tuple[int, AlarmLimit]]]]:
@@ -97,11 +128,13 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
         self.live: list[str] = []
         self.status: dict[str, int] = {}
         self.misses: dict[str, int] = {}
-        self.free_run: set[str] = set()
         self.limits: dict[tuple[str, int], AlarmLimit] = {}
-        self.outbox: list[tuple[int, int, int, int]] = []          # (source, kind, channel, value)
+        self.outbox: list[Record] = []
         self.last_fwd: dict[tuple[str, int], tuple[float, int]] = {}
-        self.last_record: tuple[int, int, int, int] | None = None
+        self.last_record: Record | None = None
+        self.scan = SonarScan()
+        self.free_run: set[str] = set()
+        self.pinged_at: float | None = None      # when the last DO_MEASURE reached the USRC (its echo heard)
         self.requested_at: float | None = None
         self.posting = False
         self.polling = False
@@ -124,14 +157,14 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
     def post_done(self, missing: list[int]) -> None:
         self.posting = False
         self.live = [r for r, a in self.sensors.items() if a not in missing]
+        if "USRC" in self.live and not T.SPU_SCAN_AHEAD_DEG:   # seed 3.2.11: no scan of its own: the sonar
+            self.free_run.add("USRC")                          # scans its circle and announces each sector
+            self.request(self.sensors["USRC"], M.FreeRun())
         # seed 3.2.13-3.2.17: the SPU sets up the alarm limits of every sensor present
         for role, msg, limits in alarm_setup():
             if role in self.live:
                 self.request(self.sensors[role], msg)
                 self.limits.update({(role, ch): lim for ch, lim in limits})
-        if "USRC" in self.live:        # seed 3.2.11: the sonar scans on its own and announces data
-            self.free_run.add("USRC")
-            self.request(self.sensors["USRC"], M.FreeRun())
         if not self.polling:
             self.polling = True
             self.poll()
@@ -150,15 +183,41 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
                          lambda s, m, role=role: (self.set_status(role, m.status), self.answered(role), self.poll()),
                          lambda role=role: (self.missed(role), self.poll()))
             return
-        cycle = [r for r in T.SPU_CYCLE if r in self.live]
+        cycle = [r for r in T.SPU_CYCLE if r in self.live and r not in self.free_run]
         if not cycle:
             self.hw.after(T.SPU_STATUS_EVERY_S, self.poll)
             return
         role = cycle[self.cycle_i % len(cycle)]
         self.cycle_i += 1
+        if role == "USRC":
+            self.sonar_step()
+            return
         self.request(self.sensors[role], M.XmitData(), (XMIT_DATA_OF[role],),
                      lambda s, m, role=role: (self.got(role, m, False), self.poll()),
                      lambda role=role: (self.missed(role), self.poll()))
+
+    def sonar_step(self) -> None:
+        """seed 3.2.11: one angle of the scan the SPU drives: turn the head, ping, fetch the echo. The echo keeps
+        the time of its ping (issue 17: the NP3 places it at the pose it had then)."""
+        usrc, angle = self.sensors["USRC"], self.scan.next()
+        self.pinged_at = None
+
+        def echo(s: int, m: M.XmitDataUsrc) -> None:
+            if m.angle == angle and self.pinged_at is not None:    # else the measurement did not succeed
+                self.got("USRC", m, False, self.pinged_at)
+            else:
+                self.answered("USRC")
+            self.poll()
+        self.request(usrc, M.HeadSetAbs(angle=angle))
+        self.request(usrc, M.DoMeasure())
+        self.request(usrc, M.XmitData(), (M.XmitDataUsrc,), echo, lambda: (self.missed("USRC"), self.poll()))
+
+    def on_echo(self, bus: str, sent: bytes, heard: bytes) -> None:
+        """The DO_MEASURE frame's clean echo: the USRC has it now and pings (the echo's time, issue 17)."""
+        cur = self.links[self.master_bus].current if self.master_bus == bus else None
+        if cur is not None and isinstance(cur.msg, M.DoMeasure) and sent == heard:
+            self.pinged_at = self.now
+        super().on_echo(bus, sent, heard)
 
     def answered(self, role: str) -> None:
         self.misses[role] = 0
@@ -183,7 +242,7 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
             # nine and every other sensor wait behind them (worst_contention seed 6: past K on the sensor bus)
             self.counts["coalesced"] += 1
             return
-        if role in self.free_run:
+        if role in self.free_run:                  # a free-running sonar's sector: pinged some time before
             if self.status.get(role, _IN_ORDER) != _IN_ORDER:
                 self.counts["ignored"] += 1       # seed 6.2: an untrustworthy sensor's data is ignored
                 return
@@ -206,7 +265,9 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
         self.hw.note("sensor_status_change", node=role, status=code)
         self.record(role, _STATUS, 0, code)       # seed 6.2: the NP3 (and the MCP on the way) learn it
 
-    def got(self, role: str, msg: M.Message, event: bool) -> None:
+    def got(self, role: str, msg: M.Message, event: bool, measured_at: float | None = None) -> None:
+        """A sensor's reply: records for the NP3 (`measured_at`: when the value was measured, if not just now)."""
+        at = self.now if measured_at is None else measured_at
         self.answered(role)
         if role not in RANGE and self.status.get(role, _IN_ORDER) == _OUT_OF_ORDER:
             self.set_status(role, _IN_ORDER)       # it answers again
@@ -218,18 +279,19 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
             lim = self.limits.get((role, ch))
             if event and lim is not None and lim.beyond(v):
                 self.last_fwd[(role, ch)] = (self.now, v)
-                self.record(role, _ALARM, ch, v)   # the limit set with SET_ALARM was crossed
+                self.record(role, _ALARM, ch, v, at)   # the limit set with SET_ALARM was crossed
                 continue
             last = self.last_fwd.get((role, ch))
             changed = change is not None and last is not None and abs(v - last[1]) >= max(change, 1)
             if last is None or changed or self.now - last[0] >= refresh:
                 self.last_fwd[(role, ch)] = (self.now, v)
-                self.record(role, _VALUE, ch, v)
+                self.record(role, _VALUE, ch, v, at)
 
     # --- records to the NP3 through the MCP (seed 3.2.2) -----------------------------------
-    def record(self, role: str, kind: int, channel: int, value: int) -> None:
+    def record(self, role: str, kind: int, channel: int, value: int, measured_at: float | None = None) -> None:
         src = self.sensors[role]
-        rec = (src, kind, channel, record_byte(value))       # signed values as their two's complement byte
+        rec = Record(src, kind, channel, record_byte(value),  # signed values as their two's complement byte
+                     self.now if measured_at is None else measured_at)
         self.counts[_KIND_NAME[kind]] += 1
         if kind != _STATUS:
             self.values[role] = self.values.get(role, 0) + 1
@@ -238,17 +300,17 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
         if self.net.reflex_from(src) is not None:            # spec reflexes (5.2): a reflex record goes first of all
             self.outbox.insert(0, rec)
         elif kind == _VALUE and role != "TPSC":              # a newer value replaces one still waiting
-            self.outbox = [r for r in self.outbox if not (r[1] == _VALUE and r[0] == src and r[2] == channel)]
+            self.outbox = [r for r in self.outbox if not (r.kind == _VALUE and r.source == src and r.channel == channel)]
             self.outbox.append(rec)
         else:                                     # alarms, status changes and contacts go first (5.2)
-            i = next((i for i, r in enumerate(self.outbox) if r[1] == _VALUE), len(self.outbox))
+            i = next((i for i, r in enumerate(self.outbox) if r.kind == _VALUE), len(self.outbox))
             self.outbox.insert(i, rec)
         if self.requested_at is None:
             self.ask_bus()
 
     def reflex_request(self, bus: str) -> bool:
         """Our XMIT_REQ carries a reflex when the record it will fetch comes from a reflex source (spec reflexes)."""
-        return bool(self.outbox) and self.net.reflex_from(self.outbox[0][0]) is not None
+        return bool(self.outbox) and self.net.reflex_from(self.outbox[0].source) is not None
 
     def ask_bus(self) -> None:
         self.requested_at = self.now
@@ -260,17 +322,20 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
             self.ask_bus()
 
     def on_xmit_grant(self, src: int, msg: M.XmitGrant) -> None:
-        np3 = ADDRESS_OF["NP3"]
         self.requested_at = None
         if not self.outbox:
             if self.last_record is not None:   # a repeated grant: the record did not get through
-                source, kind, ch, value = self.last_record
-                self.send(src, M.XmitRecord(target=np3, source=source, kind=kind, channel=ch, value=value))
+                self.send_record(src, self.last_record)
             return
-        self.last_record = source, kind, ch, value = self.outbox.pop(0)
-        self.send(src, M.XmitRecord(target=np3, source=source, kind=kind, channel=ch, value=value))
+        self.last_record = self.outbox.pop(0)
+        self.send_record(src, self.last_record)
         if self.outbox:
             self.ask_bus()
+
+    def send_record(self, mcp: int, r: Record) -> None:
+        """XMIT_RECORD (3.2.2) with the value's age now (issue 17)."""
+        self.send(mcp, M.XmitRecord(target=ADDRESS_OF["NP3"], source=r.source, kind=r.kind, channel=r.channel,
+                                    value=r.value, age=age_byte(self.now - r.measured_at)))
 
     def debug_metrics(self) -> SpuDebug:
         """Records forwarded per kind, data ignored (6.2), sensors declared silent, and the status of each."""

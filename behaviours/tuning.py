@@ -123,8 +123,14 @@ NP3_SONAR_BEAM_DEG = 15.0     # width a sonar echo is spread over on the map (40
 NP3_DR_SPEED_M_S = 0.09       # dead reckoning: forward / backward speed (bench: the gait's nominal 0.1 m/s
 NP3_DR_SIDE_M_S = 0.083       # ... loses ~10 % re-phasing), sidestep speed,
 NP3_DR_TURN_DEG_S = 22.5      # ... and turn rate on the spot (nominal 25 deg/s), all measured in sim2d
+NP3_POSE_HISTORY_S = 3.0      # dead reckoning: commands kept this long, for the pose at a record's age (issue 17;
+                              # the age field reaches 2.55 s)
 NP3_ECHO_KEEP_S = 10.0        # local memory: sonar / IR / whisker echoes at the dead-reckoned pose kept this long
-NP3_ECHO_NEAR_M = 1.5         # ... sonar echoes nearer than this only (the map keeps the rest)
+NP3_ECHO_NEAR_M = 1.5         # ... sonar echoes nearer than this only (the map keeps the rest), each as
+NP3_SONAR_CONE_POINTS = 5     # ... this many points across the beam (the reflector is somewhere on that arc);
+NP3_SONAR_CARVE_S = 5.0       # ... a ping of the last 5 s clears the points of others inside its cone
+NP3_SONAR_CARVE_DEG = 6.0     # ... (this far either side of its axis, inside the beam's 7.5 deg edge) ...
+NP3_SONAR_CARVE_TOL_M = 0.06  # ... and nearer than its own echo by this much (noise 2 cm, one step 4 cm; issue 17)
 NP3_BODY_FRONT_M = 0.15       # sensor mounts as the NP3 knows them: IR and whiskers at the body's front (CHOICE),
 NP3_IR_BEAM_DEG = 15.0        # ... the IR side beams at +-15 deg (seed 3.2.13),
 NP3_WHISKER_DEG = 25.0        # ... the whiskers 25 deg outward (CHOICE) ...
@@ -136,13 +142,18 @@ NP3_WALL_ALIGN_DEG = 6.0      # ... the wall's fitted direction this far off the
 NP3_WALL_LOST_S = 8.0         # ... no wall beside for this long: turn right to find it again
 
 # --- SPU (seed 3.2.5): polling order, status checks, alarms and forwarding rate limits to the NP3 (all CHOICE)
-SPU_CYCLE = ("IRRC", "LSC", "IRRC", "ISC", "IRRC", "TSC", "IRRC", "PSC")  # IR every 2nd poll (5.2); USRC free-runs
+SPU_CYCLE = ("IRRC", "USRC", "IRRC", "LSC", "IRRC", "USRC", "IRRC", "ISC",   # IR every 2nd poll (5.2), the
+             "IRRC", "USRC", "IRRC", "TSC", "IRRC", "USRC", "IRRC", "PSC")   # sonar every 4th: one angle of its scan
+SPU_SCAN_AHEAD_DEG = (0, 15, 30, 15, 0, -15, -30, -15)   # the sonar scan the SPU drives (HEAD_SET_ABS + DO_MEASURE,
+                              # 3.2.11; issue 17): a sweep ahead of the heading, where the robot walks and turns ...
+SPU_SCAN_ROUND_EVERY = 3      # ... and every 3rd angle one of the rest of the circle, for the map (3.3.2) ...
+SPU_SCAN_ROUND_STEP_DEG = 15  # ... in steps of the beam's width, round from the sweep's edge
 SPU_STATUS_EVERY_S = 0.5      # one STATUS_REQ to a range sensor (USRC, IRRC in turn) this often (6.2)
 SPU_SILENT_POLLS = 1          # failed transactions in a row (each with the retry) before OUT_OF_ORDER: the seed 3.2.2 rule
 SPU_XMIT_RETRY_S = 0.3        # a pending record not granted this long: XMIT_REQ again (the request may be lost)
 SPU_FORWARD = {               # VALUE records per (sensor, channel): (min change in raw steps or None, refresh s)
     "IRRC": (13, 2.0),        # 0.5 cm, the IR resolution the seed expects in practice (3.2.13)
-    "USRC": (0, 0.0),         # every sector minimum the USRC announces
+    "USRC": (0, 0.0),         # every echo of the scan
     "TPSC": (0, 0.0),         # every contact
     "ISC": (3, 5.0),          # one 3 degree step (3.2.14)
     "TSC": (2, 10.0),         # 2 degrees C

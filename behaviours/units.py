@@ -66,3 +66,12 @@ def quantizer(message: type[Message], field: str) -> Quantizer:
 
         return Quantizer(raw_log, conv.to_phys, lo, hi)
     raise ValueError(f"{message.NAME}.{field} has no physical conversion")
+
+
+# spec XMIT_RECORD / DATA `age` (issue 17): how long ago the source measured the value, saturating
+RECORD_AGE = quantizer(_M.XmitRecord, "age")
+
+
+def age_byte(seconds: float) -> int:
+    """A record's age field for a value measured `seconds` ago (older than the field reaches: its top)."""
+    return RECORD_AGE.raw(max(0.0, seconds))

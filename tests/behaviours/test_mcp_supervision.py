@@ -54,7 +54,7 @@ def send_record(rig, bus, src: int, rec: M.Message, at: float) -> None:
 
 
 def record(source: str, kind: RecordKind, value: int, channel: int = 0) -> M.XmitRecord:
-    return M.XmitRecord(target=NP3, source=A[source], kind=int(kind), channel=channel, value=value)
+    return M.XmitRecord(target=NP3, source=A[source], kind=int(kind), channel=channel, value=value, age=0)
 
 
 def notes(rig, event: str):

@@ -10,9 +10,9 @@ from arachnae_proto import messages as M
 from arachnae_proto.enums import MmcError, MovCmd, RangeStatus, RecordKind, TpscContact
 from arachnae_proto.network import ADDRESS_OF
 from behaviours import tuning as T
-from behaviours.np3 import DeadReckoning, decode
+from behaviours.np3 import DeadReckoning, Echo, Ping, decode
 from behaviours.np3_layers import TaskModule, Tuning, body_frame, clear_ahead, light_gradient, np3_network, wall_beside
-from behaviours.units import quantizer
+from behaviours.units import age_byte, quantizer
 from tests.behaviours.rig import Rig
 
 MCP, NP3 = ADDRESS_OF["MCP"], ADDRESS_OF["NP3"]
@@ -30,8 +30,8 @@ def np3(spec, task: str = "forward") -> Rig:
     return rig
 
 
-def data(role: str, value: int, kind: int = VALUE, channel: int = 0) -> M.Data:
-    return M.Data(address=ADDRESS_OF[role], kind=kind, channel=channel, value=value)
+def data(role: str, value: int, kind: int = VALUE, channel: int = 0, age_s: float = 0.0) -> M.Data:
+    return M.Data(address=ADDRESS_OF[role], kind=kind, channel=channel, value=value, age=age_byte(age_s))
 
 
 def moves(rig: Rig) -> list[tuple[float, MovCmd]]:
@@ -331,3 +331,55 @@ def test_a_pit_under_a_rear_foot_is_left_forwards_and_stays_on_the_map(spec):
     (i, j), = g.barriers
     g.mark_free(*g.centre(i, j), 0.3)                                               # walking there later ...
     assert g.state(i, j) == 2                                                       # ... does not clear it
+
+
+def test_dead_reckoning_knows_the_pose_at_an_earlier_time():
+    """issue 17: a record's age asks for the pose the robot had when the value was measured."""
+    odo = DeadReckoning(0.1, math.radians(25))
+    odo.command(1.0, int(MovCmd.FORWARD))
+    odo.command(2.0, int(MovCmd.TURN_LEFT))
+    odo.command(3.8, int(MovCmd.STOP))
+    odo.advance(4.0)
+    assert odo.pose_at(0.5) == pytest.approx((0.0, 0.0, 0.0))
+    assert odo.pose_at(1.5) == pytest.approx((0.05, 0.0, 0.0))
+    x, y, th = odo.pose_at(2.9)                                   # half way through the turn
+    assert (x, y, math.degrees(th)) == pytest.approx((0.1, 0.0, 22.5))
+    assert odo.pose_at(5.0) == odo.pose and math.degrees(odo.pose[2]) == pytest.approx(45.0)
+
+
+def test_a_sonar_echo_is_placed_at_the_heading_of_its_ping(spec):
+    """issue 17: while turning, an echo that arrives 1.5 s after its ping lies where the ping saw it."""
+    metres = quantizer(M.XmitDataUsrc, "distance")
+    rig = np3(spec, task="idle")
+    rig.run(1.0)
+    odo = DeadReckoning(0.1, math.radians(22.5))
+    odo.command(0.0, int(MovCmd.TURN_LEFT))
+    odo.command(2.0, int(MovCmd.STOP))                             # 45 deg at t = 2 s
+    rig.node.odo = odo
+    rig.inject(2.5, MCP, data("USRC", metres.raw(1.0), VALUE, channel=0, age_s=1.5))   # pinged at 1.0 s: 22.5 deg
+    rig.run(2.6)
+    pts = [e for e in rig.node.echoes if e.sonar]
+    assert len(pts) == T.NP3_SONAR_CONE_POINTS
+    mid = pts[len(pts) // 2]
+    d = metres.phys(metres.raw(1.0))
+    assert (mid.x, mid.y) == pytest.approx((d * math.cos(math.radians(22.5)), d * math.sin(math.radians(22.5))),
+                                           abs=0.02)
+
+
+def test_a_later_ping_clears_the_cone_points_it_shows_free_and_keeps_the_wall(spec):
+    """issue 17: in a corridor (walls 0.25 m either side) a ping 15 deg off the axis puts the inner edge of its
+    cone into the legs' way; a ping from 0.3 m further on, whose cone passes over that spot, clears it; the
+    wall's points and an IR point stay."""
+    rig = np3(spec, task="idle")
+    rig.run(1.0)
+    node = rig.node
+    node.echoes.append(Echo(1.0, 0.45, 0.10, 0.0, 0.0))           # an IR point: the sonar never clears it
+    node.sonar_memory(Ping(1.0, 0.0, 0.0, math.radians(15), 0.25 / math.sin(math.radians(22.5))), 15.0)
+    band = Tuning().body_half_width_m + Tuning().guard_margin_m   # the guard's band beside the body
+    first = [e for e in node.echoes if e.sonar]
+    assert min(e.y for e in first) < band
+    node.sonar_memory(Ping(1.2, 0.3, 0.0, math.radians(15), 0.25 / math.sin(math.radians(22.5))), 15.0)
+    kept = [e for e in first if e in node.echoes]
+    assert len(kept) >= 2 and min(e.y for e in kept) > band
+    assert max(e.y for e in kept) == pytest.approx(0.25)           # the wall itself stays
+    assert Echo(1.0, 0.45, 0.10, 0.0, 0.0) in node.echoes

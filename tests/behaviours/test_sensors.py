@@ -9,6 +9,7 @@ from arachnae_proto.network import ADDRESS_OF as A
 
 from behaviours import tuning as T
 from behaviours.runtime import BusTiming
+from behaviours.spu import Record
 from behaviours.units import quantizer
 from tests.behaviours.rig import Rig
 
@@ -252,7 +253,7 @@ def test_the_spu_request_carrying_a_contact_leads_an_ordinary_one_on_the_first_b
         b.busy_until["first"] = 1.0
         b.line_idle_s = lambda bus, b=b: max(0.0, b.t - b.busy_until.get(bus, 0.0)) if b.t >= 1.0 else 0.0
         if reflex:
-            rig.node.outbox = [(A["TPSC"], 0, 0, 16)]
+            rig.node.outbox = [Record(A["TPSC"], 0, 0, 16, 0.9)]
         b.after(0.999 - b.t, rig.node.slave_send, A["MCP"], M.XmitReq())
         rig.run(1.1)
         starts[role] = next(t for t, f in rig.frames(M.XmitReq))

@@ -1,8 +1,11 @@
 """SPU (seed 3.2.5, 6.2): alarm set-up after POST, records to the NP3, status checks, untrusted sensors ignored."""
 from __future__ import annotations
 
+import pytest
+
 from arachnae_proto import messages as M
 from arachnae_proto.enums import RangeStatus, RecordKind, TpscContact
+from arachnae_proto.frame import build
 from arachnae_proto.network import ADDRESS_OF as A
 
 from behaviours import tuning as T
@@ -24,13 +27,14 @@ class Bus:
         self.silent: set[str] = set()
         self.ir_cm = 9.0
         self.volts = 4.8
+        self.head = 0
 
     def data(self, short: str) -> M.Message:
         if short == "IRRC":
             r = IR.raw(self.ir_cm)
             return M.XmitDataIrrc(left=255, center=r, right=255)
         if short == "USRC":
-            return M.XmitDataUsrc.from_phys(distance=2.0, angle=40)
+            return M.XmitDataUsrc.from_phys(distance=2.0, angle=self.head)
         if short == "TPSC":
             return M.XmitDataTpsc(contact=int(TpscContact.OBJ_LEFT))
         if short == "ISC":
@@ -56,6 +60,8 @@ class Bus:
             return [(a, M.StatusAckOrder(status=0))]
         if isinstance(m, M.XmitData):
             return [(a, self.data(short))]
+        if isinstance(m, M.HeadSetAbs):
+            self.head = m.angle
         return []
 
 
@@ -71,9 +77,9 @@ def records(rig, source: str | None = None, kind: int | None = None, after: floa
             and (source is None or f.message.source == A[source]) and (kind is None or f.message.kind == kind)]
 
 
-def test_after_post_every_sensor_gets_its_alarm_limits_and_the_sonar_free_runs(spec):
+def test_after_post_every_sensor_gets_its_alarm_limits_and_the_sonar_scans(spec):
     rig, _ = spu(spec)
-    assert [f.dst for _, f in rig.frames(M.FreeRun)] == [A["USRC"]]                  # seed 3.2.11
+    assert rig.frames(M.FreeRun) == []                # the SPU drives the sonar's scan (issue 17)
     (_, ir), = rig.frames(M.SetAlarmIrrc)
     assert ir.dst == A["IRRC"] and ir.message == M.SetAlarmIrrc.from_phys(limit=T.SPU_ALARM_IRRC_CM)
     assert sorted(f.message.channel for _, f in rig.frames(M.SetAlarmIsc)) == [0, 1]    # per axis
@@ -81,11 +87,44 @@ def test_after_post_every_sensor_gets_its_alarm_limits_and_the_sonar_free_runs(s
     assert rig.frames(M.SetAlarmLsc)[0][1].message == M.SetAlarmLsc.from_phys(limit=T.SPU_ALARM_LSC_LX)
     assert rig.frames(M.SetAlarmPsc)[0][1].message == M.SetAlarmPsc.from_phys(limit=T.SPU_ALARM_PSC_V)
     polled = {f.dst for _, f in rig.frames(M.XmitData)}
-    assert A["USRC"] not in polled and A["IRRC"] in polled                          # the sonar announces itself
+    assert {A["USRC"], A["IRRC"]} <= polled
+
+
+def test_the_sonar_scan_sweeps_ahead_and_steps_round_the_circle(spec):
+    """seed 3.2.11, issue 17: HEAD_SET_ABS, DO_MEASURE, XMIT_DATA per angle; most angles ahead of the heading."""
+    rig, _ = spu(spec, until=8.0)
+    usrc = [f.message for _, _b, f in rig.sent if f.dst == A["USRC"]
+            and isinstance(f.message, (M.HeadSetAbs, M.DoMeasure, M.XmitData))]
+    assert len(usrc) >= 3 * 10
+    angles = [m.angle for m in usrc if isinstance(m, M.HeadSetAbs)]
+    for k, a in enumerate(angles):                    # each angle: turn, ping, fetch, in that order
+        assert [type(m) for m in usrc[3 * k:3 * k + 3]] == [M.HeadSetAbs, M.DoMeasure, M.XmitData][:len(usrc) - 3 * k]
+        assert usrc[3 * k].angle == a
+    edge = max(abs(a) for a in T.SPU_SCAN_AHEAD_DEG)
+    ahead = [a for a in angles if (a + 180) % 360 - 180 in T.SPU_SCAN_AHEAD_DEG]
+    rest = [a for a in angles if edge < a < 360 - edge]
+    assert len(ahead) + len(rest) == len(angles) and rest
+    assert len(ahead) == pytest.approx(len(angles) * (1 - 1 / T.SPU_SCAN_ROUND_EVERY), abs=1)
+    assert rest == list(range(edge + T.SPU_SCAN_ROUND_STEP_DEG, 360, T.SPU_SCAN_ROUND_STEP_DEG))[:len(rest)]
+    got = {r.channel for r in records(rig, "USRC", int(RecordKind.VALUE))}
+    assert got and got <= set(angles)                 # each echo with the head angle it was pinged at
+
+
+def test_a_sonar_record_carries_the_time_since_its_ping(spec):
+    """issue 17: the XMIT_RECORD's age is the time from the DO_MEASURE (the ping) to the record's sending."""
+    rig, _ = spu(spec, until=6.0)
+    char_s = BusTiming("sensor").char_s
+    pings = [t + len(build(A["USRC"], SPU, f.message)) * char_s for t, f in rig.frames(M.DoMeasure)]  # frame ends
+    sent = [(t, f.message) for t, f in rig.frames(M.XmitRecord) if f.message.source == A["USRC"]]
+    assert len(sent) >= 3
+    age_q = quantizer(M.XmitRecord, "age")
+    for t, rec in sent:
+        ping = max(p for p in pings if p < t)
+        assert age_q.phys(rec.age) == pytest.approx(t - ping, abs=0.006) and rec.age > 0
 
 
 def test_ir_values_travel_per_beam_with_their_channel(spec):
-    rig, _ = spu(spec)
+    rig, _ = spu(spec, until=6.0)
     ir = records(rig, "IRRC", int(RecordKind.VALUE))
     assert {(r.channel, r.value) for r in ir} == {(0, 255), (1, IR.raw(9.0)), (2, 255)}
     assert all(r.target == NP3 for r in ir)
@@ -125,18 +164,17 @@ def test_an_ir_status_change_announced_with_data_rdy_is_fetched_at_once(spec):
 def test_an_unreliable_sonar_is_ignored(spec):
     """seed 6.2: the US system is declared untrustworthy and its data ignored."""
     rig, bus = spu(spec)
-    rig.inject(3.0, A["USRC"], M.DataRdy())
-    rig.run(3.5)
-    assert len(records(rig, "USRC", int(RecordKind.VALUE))) == 1
+    before = len(records(rig, "USRC", int(RecordKind.VALUE)))
+    assert before >= 1
     bus.status["USRC"] = int(RangeStatus.UNRELIABLE)
-    rig.run(3.5 + 2 * T.SPU_STATUS_EVERY_S + 0.5)
+    rig.run(3.0 + 2 * T.SPU_STATUS_EVERY_S + 0.5)
     assert [r.value for r in records(rig, "USRC", int(RecordKind.STATUS))] == [RangeStatus.UNRELIABLE]
     t = rig.board.t
-    for k in range(5):
-        rig.inject(t + 0.3 * k, A["USRC"], M.DataRdy())
-    rig.run(t + 2.0)
-    assert len(records(rig, "USRC", int(RecordKind.VALUE))) == 1
-    assert rig.node.debug_metrics()["ignored"] == 5
+    n = len(records(rig, "USRC", int(RecordKind.VALUE)))
+    ignored = rig.node.debug_metrics()["ignored"]
+    rig.run(t + 3.0)
+    assert len(records(rig, "USRC", int(RecordKind.VALUE))) == n        # the scan goes on, nothing forwarded
+    assert rig.node.debug_metrics()["ignored"] > ignored
 
 
 def test_a_sensor_that_stops_answering_is_out_of_order(spec):
@@ -176,10 +214,11 @@ def test_asked_for_its_id_again_after_reporting_the_spu_runs_a_new_post(spec):
     assert polls_after                                      # polling resumed after the new POST
 
 
-def test_a_sensor_announcing_again_before_its_fetch_goes_out_is_fetched_once(spec):
+def test_a_sensor_announcing_again_before_its_fetch_goes_out_is_fetched_once(spec, monkeypatch):
     """seed 3.2.2 / arbitration model: one request per slave. DATA_RDYs while the sonar's fetch still waits for the
     line add none (the free-running USRC had piled up nine, every other sensor past K); an urgent fetch is not
     folded into an ordinary poll of the same sensor still waiting (that one comes last)."""
+    monkeypatch.setattr(T, "SPU_SCAN_AHEAD_DEG", ())         # a free-running sonar: fetched only when it announces
     rig, _ = spu(spec)
     t = rig.board.t
     for k in range(3):
@@ -192,3 +231,13 @@ def test_a_sensor_announcing_again_before_its_fetch_goes_out_is_fetched_once(spe
     assert len([1 for at, _f in rig.frames(M.XmitData, A["USRC"]) if at >= t]) == 1
     assert rig.node.debug_metrics()["coalesced"] == 2
 
+
+def test_without_a_scan_of_its_own_the_sonar_free_runs_and_announces_its_sectors(spec, monkeypatch):
+    """seed 3.2.11: SPU_SCAN_AHEAD_DEG empty: FREE_RUN, the sonar is fetched when it announces, never polled."""
+    monkeypatch.setattr(T, "SPU_SCAN_AHEAD_DEG", ())
+    rig, _ = spu(spec)
+    assert [f.dst for _, f in rig.frames(M.FreeRun)] == [A["USRC"]]
+    assert A["USRC"] not in {f.dst for _, f in rig.frames(M.XmitData)} and rig.frames(M.HeadSetAbs) == []
+    rig.inject(3.0, A["USRC"], M.DataRdy())
+    rig.run(3.5)
+    assert len(records(rig, "USRC", int(RecordKind.VALUE))) == 1

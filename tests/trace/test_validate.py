@@ -180,7 +180,7 @@ def test_a_reflex_relayed_again_after_a_new_record_is_no_resend(saved, tmp_path,
         return r
 
     stop = frame.build(mmc, mcp, M.MoveRelayed(address=tpsc, mov_cmd=int(MovCmd.STOP), param=0))
-    record = frame.build(mcp, spu, M.XmitRecord(target=np3, source=tpsc, kind=int(RecordKind.VALUE), channel=0, value=64))
+    record = frame.build(mcp, spu, M.XmitRecord(target=np3, source=tpsc, kind=int(RecordKind.VALUE), channel=0, value=64, age=0))
     added = [row(end + 0.001, end + 0.009, "MCP", "MMC", stop, "MOVE_RELAYED")]
     if new_record:
         added.append(row(end + 0.010, end + 0.022, "SPU", "MCP", record, "XMIT_RECORD"))
