@@ -63,6 +63,7 @@ class Tuning:
     avoid_side_m: float = T.NP3_AVOID_SIDE_M
     avoid_sonar_m: float = T.NP3_AVOID_SONAR_M
     avoid_turn_s: float = T.NP3_AVOID_TURN_S
+    avoid_keep_side_s: float = T.NP3_AVOID_KEEP_SIDE_S
     pit_back_s: float = T.NP3_PIT_BACK_S
     pit_turn_s: float = T.NP3_PIT_TURN_S
     tilt_limit_deg: float = T.NP3_TILT_LIMIT_DEG
@@ -288,11 +289,17 @@ def closing_in(points: list[Point], cmd: Any, t: Tuning) -> float:
 
 def safe_instead(points: list[Point], cmd: Any, t: Tuning) -> Any:
     """The command to give instead of an unsafe `cmd`: the closest safe alternative (turn the other way,
-    turn towards the freer side, back off), STOP when nothing is safe."""
+    turn towards the freer side, back off), STOP when nothing is safe. A turn refused whose other way turns
+    towards the crowded side (a wall along one flank that also closes in ahead: the end swings into it one
+    way, the nose the other) sidesteps away from that side first: turning back towards it undid the
+    avoidance that had turned away, and the two took turns in front of the wall (scenarios/sonar_first.yaml)."""
     crowd = sum(1 if by > 0 else -1 for bx, by, _s, _a in points if abs(bx) < 0.4 and abs(by) < 0.4)
     freer = (RIGHT, LEFT) if crowd > 0 else (LEFT, RIGHT)
+    away = SIDE_RIGHT if crowd > 0 else SIDE_LEFT
     options = {FORWARD: (*freer, BACKWARD), BACKWARD: freer, LEFT: (RIGHT, BACKWARD, FORWARD),
                RIGHT: (LEFT, BACKWARD, FORWARD), SIDE_LEFT: (SIDE_RIGHT, *freer), SIDE_RIGHT: (SIDE_LEFT, *freer)}
+    if crowd and cmd == freer[0]:                     # the other way is towards the crowded side
+        options[cmd] = (away, *options[cmd])
     for alt in options.get(cmd, ()):
         if closing_in(points, alt, t) == 0.0:
             return alt
@@ -301,7 +308,13 @@ def safe_instead(points: list[Point], cmd: Any, t: Tuning) -> Any:
 
 # --------------------------------------------------------------------------- level 1: avoidance
 def avoid_trigger(t: Tuning) -> Trigger:
-    """seed 5.1.2: an obstacle ahead (IR centre or side beam, or the sonar looking ahead) -> turn away from it."""
+    """seed 5.1.2: an obstacle ahead (IR centre or side beam, or the sonar looking ahead) -> turn away from it.
+    Without an IR beam to say which side is nearer, the side is chosen on the echo memory and then kept while
+    avoidance goes on (the next turn within avoid_keep_side_s): the sonar scans only ahead of the heading, so
+    after a turn the memory shows the side turned to as seen and the other as unknown, and choosing again
+    turned the robot back and forth in front of a wall (issue 17, scenarios/sonar_first.yaml)."""
+    last: list[tuple[float, Any]] = []          # (when, turn) of the last avoidance turn
+
     def trigger(i: Mapping[str, Any], now: float) -> Steps | None:
         left, centre, right = _seen(i.get("ir"))
         sonar = i.get("sonar_ahead_m")
@@ -315,6 +328,8 @@ def avoid_trigger(t: Tuning) -> Trigger:
             return None
         if left is not None or right is not None:
             turn = RIGHT if (left or math.inf) < (right or math.inf) else LEFT
+        elif last and now - last[0][0] <= t.avoid_turn_s + t.avoid_keep_side_s:
+            turn = last[0][1]                  # still avoiding: on round the same way
         else:                                  # the side whose heading after the turn the memory shows clearer
             turn_rad = math.radians(t.turn_rate_deg_s * t.avoid_turn_s)
             ahead = {c: clear_ahead(rotated(pts, sign * turn_rad), t.avoid_half_width_m, t.body_half_length_m)
@@ -324,6 +339,7 @@ def avoid_trigger(t: Tuning) -> Trigger:
             else:                              # the side with less in front of it
                 crowd = [by for bx, by, _s, _a in pts if 0 < bx < 2 * t.avoid_echo_m and abs(by) < 3 * t.avoid_half_width_m]
                 turn = RIGHT if sum(1 if by > 0 else -1 for by in crowd) > 0 else LEFT
+        last[:] = [(now, turn)]
         return [(t.avoid_turn_s, turn)]
     return trigger
 

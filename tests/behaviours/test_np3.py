@@ -307,6 +307,11 @@ def test_the_motion_check_refuses_only_moves_that_close_in_on_an_echo():
     assert safe_instead(boxed, MovCmd.FORWARD, t) == MovCmd.STOP     # nothing is safe: stand still
     far = [(1.5, 0.0, 0.0, 0.05)]
     assert all(closing_in(far, c, t) == 0 for c in MovCmd)
+    # a wall along the left flank that closes in ahead: turning right swings the rear into it, and turning left
+    # (towards it) is what avoidance had turned away from: sidestep away from it (scenarios/sonar_first.yaml)
+    flank = [(x / 20, 0.14 - (x / 20 + 0.2) * 0.05, 90.0, 0.0) for x in range(-4, 7)]    # 6 cm off the rear corner
+    assert closing_in(flank, MovCmd.TURN_RIGHT, t) > 0 and closing_in(flank, MovCmd.SIDESTEP_RIGHT, t) == 0
+    assert safe_instead(flank, MovCmd.TURN_RIGHT, t) == MovCmd.SIDESTEP_RIGHT
 
 
 def test_a_refused_command_hands_the_actuator_to_the_guard_reflex(spec):

@@ -146,6 +146,26 @@ def test_avoidance_turns_away_from_the_nearer_side_and_task_resumes():
     assert resumed == pytest.approx(0.8 + 0.3, abs=0.11)   # turn plan, then the hold releases
 
 
+def test_avoidance_on_the_echo_memory_keeps_turning_the_way_it_started():
+    """issue 17 (scenarios/sonar_first.yaml): a wall ahead seen by the sonar only; after the first turn the memory
+    shows the side turned to as seen (a wall) and the other as unknown, and choosing again turned the robot back."""
+    clock = FakeClock()
+    net = np3_network(clock, task="forward")
+    wall_right = tuple((0.3, y / 10, 0.0, 0.0) for y in range(-6, 1))       # a wall 0.3 m ahead, right of the axis
+    net.sense(pose=(0.0, 0.0, 0.0), echoes=wall_right)
+    assert net.step()["move"] == MovCmd.TURN_LEFT                             # the clearer side
+    wall_left = tuple((0.3, y / 10, 0.0, 0.0) for y in range(0, 7))          # now only its other end seen, ahead
+    net.sense(echoes=wall_left)
+    clock.t = 0.9                                                             # the next turn: the same way
+    assert net.step()["move"] == MovCmd.TURN_LEFT
+    net.sense(echoes=())
+    clock.t = 2.5
+    assert net.step()["move"] == MovCmd.FORWARD                               # clear: the task again
+    net.sense(echoes=wall_left)
+    clock.t = 10.0                                                            # a new obstacle long after: chosen anew
+    assert net.step()["move"] == MovCmd.TURN_RIGHT
+
+
 def test_wiring_table_lists_every_declared_connection():
     net = np3_network(FakeClock(), task="explore")
     table = net.wiring_table()

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import pytest
 
-from sim2d.metrics import reactions
+from sim2d.metrics import lookup, reactions
 
 FWD, BACK, LEFT = 1, 2, 4
 
@@ -43,3 +43,10 @@ def test_each_reaction_record_names_its_stimulus_and_whether_it_was_answered():
     recs = reactions([(3.0, "whisker"), (6.0, "ir")], [(3.3, BACK)], [(3.2, 5.0)], 1.0, 9.0)
     assert [(r["kind"], r["stimulus_s"], r["move_s"], r["answered"]) for r in recs] == [
         ("whisker", 3.0, 3.3, True), ("ir", 6.0, 9.0, False)]
+
+
+def test_a_note_never_written_counts_zero_and_other_absent_metrics_are_none():
+    """A scenario can expect that something never happened (scenarios/sonar_first.yaml: no close-up stimulus)."""
+    m = {"notes": {"escape": {"count": 2, "first_s": 1.0}}, "nodes": {}}
+    assert lookup(m, "notes.escape.count") == 2 and lookup(m, "notes.stimulus.count") == 0
+    assert lookup(m, "notes.stimulus.first_s") is None and lookup(m, "nodes.NP3.map.routes") is None
