@@ -510,9 +510,12 @@ class NP3(Runtime, Np3Skeleton):
 
     def sonar_memory(self, ping: Ping, rel_deg: float) -> None:
         """Issue 17: a sonar echo is the nearest reflector anywhere across the beam, so it joins the local memory
-        as points spread over the cone (each with the beam's whole arc: clear_ahead counts only echoes surely
-        in the way); what a ping shows free (nearer than its echo) clears the points of other pings there. In a corridor the cone's inner edge lies inside the legs' way, and only the
-        pings from further on, whose cones pass over that spot, show it free."""
+        as points spread over the cone, each with how far across the beam the reflector may lie from it (to the
+        cone's far edge: clear_ahead counts only echoes surely in the way; a point at the cone's edge is not the
+        centre of the arc, and giving it the half-width made a wall alongside seen 15 deg off the axis a corner
+        ahead, wall_follow); what a ping shows free (nearer than its echo) clears the points of other pings
+        there. In a corridor the cone's inner edge lies inside the legs' way, and only the pings from further
+        on, whose cones pass over that spot, show it free."""
         while self.pings and ping.t - self.pings[0].t > T.NP3_SONAR_CARVE_S:
             self.pings.popleft()
         if any(e.sonar and ping.clears(e.x, e.y) for e in self.echoes):
@@ -520,10 +523,10 @@ class NP3(Runtime, Np3Skeleton):
         if ping.reach < T.NP3_ECHO_NEAR_M:
             n = T.NP3_SONAR_CONE_POINTS
             half = math.radians(T.NP3_SONAR_BEAM_DEG / 2)
-            arc = ping.reach * math.sin(half)     # each point: the reflector may lie anywhere across the beam
             for k in range(n):
                 off = -half + 2 * half * k / (n - 1)
                 px, py = ping.x + ping.reach * math.cos(ping.bearing + off), ping.y + ping.reach * math.sin(ping.bearing + off)
+                arc = ping.reach * (math.sin(half) + abs(math.sin(off)))   # the reflector: anywhere up to the far edge
                 if not any(p.clears(px, py) for p in self.pings):
                     self.echoes.append(Echo(self.now, px, py, rel_deg + math.degrees(off), arc, sonar=True))
         self.pings.append(ping)

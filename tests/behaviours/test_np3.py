@@ -388,3 +388,23 @@ def test_a_later_ping_clears_the_cone_points_it_shows_free_and_keeps_the_wall(sp
     assert len(kept) >= 2 and min(e.y for e in kept) > band
     assert max(e.y for e in kept) == pytest.approx(0.25)           # the wall itself stays
     assert Echo(1.0, 0.45, 0.10, 0.0, 0.0) in node.echoes
+
+
+def test_a_wall_alongside_seen_off_the_axis_is_no_obstacle_ahead(spec):
+    """issue 17 (wall_follow): the wall 0.35 m to the right, a ping 15 deg right of the axis meets it at the cone's
+    outer edge; the cone's inner points lie in the corridor ahead, but the reflector may be anywhere up to the
+    outer edge, so none is surely in the way (they had made a corner out of nothing). Looking straight at a
+    wall 0.4 m ahead, every point of the cone is."""
+    rig = np3(spec, task="idle")
+    rig.run(1.0)
+    node = rig.node
+    edge = math.radians(15 + T.NP3_SONAR_BEAM_DEG / 2)
+    node.sonar_memory(Ping(1.0, 0.0, 0.0, math.radians(-15), 0.35 / math.sin(edge)), -15.0)
+    pts = body_frame(tuple(e.point() for e in node.echoes), (0.0, 0.0, 0.0))
+    assert len(pts) == T.NP3_SONAR_CONE_POINTS and min(abs(p[1]) for p in pts) < 0.15    # inner edge in the way
+    assert clear_ahead(pts, T.NP3_WALL_TARGET_M - T.NP3_WALL_DEADBAND_M) == math.inf
+    before = len(node.echoes)
+    node.sonar_memory(Ping(1.1, 0.0, 0.0, 0.0, 0.4), 0.0)
+    ahead = body_frame(tuple(e.point() for e in list(node.echoes)[before:]), (0.0, 0.0, 0.0))
+    assert len(ahead) == T.NP3_SONAR_CONE_POINTS
+    assert all(clear_ahead([p], T.NP3_AVOID_HALF_WIDTH_M) == pytest.approx(p[0]) for p in ahead)
