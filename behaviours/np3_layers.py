@@ -330,12 +330,9 @@ def avoid_trigger(t: Tuning) -> Trigger:
             turn = RIGHT if (left or math.inf) < (right or math.inf) else LEFT
         elif last and now - last[0][0] <= t.avoid_turn_s + t.avoid_keep_side_s:
             turn = last[0][1]                  # still avoiding: on round the same way
-        else:   # the side whose heading after the turn the memory shows clearer, every point taken as it lies
-            # (a wall alongside seen at a slant is not surely in the way, but it is not clear either: at a corner
-            # turning towards it had the task turn back, wall_follow)
+        else:                                  # the side whose heading after the turn the memory shows clearer
             turn_rad = math.radians(t.turn_rate_deg_s * t.avoid_turn_s)
-            lying = [(bx, by, seen, 0.0) for bx, by, seen, _arc in pts]
-            ahead = {c: clear_ahead(rotated(lying, sign * turn_rad), t.avoid_half_width_m, t.body_half_length_m)
+            ahead = {c: clear_ahead(rotated(pts, sign * turn_rad), t.avoid_half_width_m, t.body_half_length_m)
                      for c, sign in ((LEFT, 1.0), (RIGHT, -1.0))}
             if ahead[LEFT] != ahead[RIGHT]:
                 turn = LEFT if ahead[LEFT] > ahead[RIGHT] else RIGHT
