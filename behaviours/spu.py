@@ -65,19 +65,28 @@ class Record(NamedTuple):
 
 class SonarScan:
     """The angles (body frame, 0..359) of the sonar scan the SPU drives, one per poll (issue 17): the sweep ahead of
-    the heading, and every SPU_SCAN_ROUND_EVERY-th angle one step round the rest of the circle, for the map."""
+    the heading, and every SPU_SCAN_ROUND_EVERY-th angle one off it: mostly a side angle, the two sides in turn (a
+    wall alongside needs an echo every few seconds: with the whole circle in turn a side came round every ~34 s
+    and wall_follow lost its wall at a corner), between them one step round the rest of the circle, for the map."""
 
     def __init__(self) -> None:
         edge = max((abs(a) for a in T.SPU_SCAN_AHEAD_DEG), default=0)
         self.ahead = [a % 360 for a in T.SPU_SCAN_AHEAD_DEG]
-        self.round = list(range(edge + T.SPU_SCAN_ROUND_STEP_DEG, 360 - edge, T.SPU_SCAN_ROUND_STEP_DEG))
-        self.steps = self.ahead_i = self.round_i = 0
+        self.sides = [a % 360 for a in T.SPU_SCAN_SIDE_DEG]
+        self.round = [a for a in range(edge + T.SPU_SCAN_ROUND_STEP_DEG, 360 - edge, T.SPU_SCAN_ROUND_STEP_DEG)
+                      if a not in self.sides]
+        self.steps = self.ahead_i = self.round_i = self.side_i = self.off_i = 0
 
     def next(self) -> int:
         self.steps += 1
-        if self.round and self.steps % T.SPU_SCAN_ROUND_EVERY == 0:
-            self.round_i += 1
-            return self.round[(self.round_i - 1) % len(self.round)]
+        if (self.round or self.sides) and self.steps % T.SPU_SCAN_ROUND_EVERY == 0:
+            self.off_i += 1
+            rest_turn = self.off_i % (T.SPU_SCAN_SIDES_PER_ROUND + 1) == 0
+            if self.round and (rest_turn or not self.sides):
+                self.round_i += 1
+                return self.round[(self.round_i - 1) % len(self.round)]
+            self.side_i += 1
+            return self.sides[(self.side_i - 1) % len(self.sides)]
         self.ahead_i += 1
         return self.ahead[(self.ahead_i - 1) % len(self.ahead)]
 

@@ -148,7 +148,9 @@ SPU_CYCLE = ("IRRC", "USRC", "IRRC", "LSC", "IRRC", "USRC", "IRRC", "ISC",   # I
 SPU_SCAN_AHEAD_DEG = (0, 15, 30, 15, 0, -15, -30, -15)   # the sonar scan the SPU drives (HEAD_SET_ABS + DO_MEASURE,
                               # 3.2.11; issue 17): a sweep ahead of the heading, where the robot walks and turns ...
 SPU_SCAN_ROUND_EVERY = 3      # ... and every 3rd angle one of the rest of the circle, for the map (3.3.2) ...
-SPU_SCAN_ROUND_STEP_DEG = 15  # ... in steps of the beam's width, round from the sweep's edge
+SPU_SCAN_ROUND_STEP_DEG = 15  # ... in steps of the beam's width, round from the sweep's edge ...
+SPU_SCAN_SIDE_DEG = (90, -90, 75, -75, 105, -105)   # ... but mostly the sides, left and right in turn, where a
+SPU_SCAN_SIDES_PER_ROUND = 2  # wall alongside is followed: 2 side angles, then one of the rest of the circle
 SPU_STATUS_EVERY_S = 0.5      # one STATUS_REQ to a range sensor (USRC, IRRC in turn) this often (6.2)
 SPU_SILENT_POLLS = 1          # failed transactions in a row (each with the retry) before OUT_OF_ORDER: the seed 3.2.2 rule
 SPU_XMIT_RETRY_S = 0.3        # a pending record not granted this long: XMIT_REQ again (the request may be lost)
