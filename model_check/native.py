@@ -228,6 +228,97 @@ out:
 """ % {"bound": L_BOUND, "overflow": L_OVERFLOW, "violation": L_VIOLATION, "fair": L_FAIR_ONLY}
 
 
+# The parallel search's three steps (model_check.parallel), around `bfs`'s hash table and rows.
+# pexpand (one thread per slice of a layer, at once): expand the stored states i .. stop-1 against
+# the table as it is, read only; a successor not in it becomes a candidate, deduplicated in a
+# table of the thread's own, with where its probe of the shared table stopped (slot, step).
+# pmerge (one thread after another, in slice order): the candidates into the shared table, from
+# where their probe stopped: a new state gets the next id, as `bfs` gives it, since the slices
+# are consecutive and a candidate's first edge is its first in the layer. pfix (all threads):
+# each edge's candidate number becomes the id, the edges go to their place in the store.
+_PARALLEL = """\
+void pexpand(int64_t i, int64_t stop, const uint8_t *keys, int64_t width, const int32_t *table, int64_t tbits,
+             int64_t cap, int32_t *ev, RULE_T *er, uint8_t *crow, int32_t *cpar, int64_t *cslot, int64_t *cstep,
+             int32_t *clocal, int32_t *ltable, int64_t lbits, uint16_t *degree, Res *r) {
+    U tmask = ((U)1 << tbits) - 1, lmask = ((U)1 << lbits) - 1, s[W];
+    U succ[NRULES * W]; int32_t sr[NRULES];
+    uint8_t tb[W * 8];
+    int64_t ne = 0, nc = 0;
+    r->kind = 0;
+    for (; i < stop; i++) {
+        if (ne + NRULES > cap) { r->kind = HIT_FULL; break; }
+        const uint8_t *row = keys + (size_t)i * (size_t)width;
+        memset(s, 0, sizeof s);
+        for (int64_t j = 0; j < width; j++) s[j >> 3] |= (U)row[j] << (8 * (j & 7));
+        int64_t k = visit(s, succ, sr, r);
+        if (k < 0) break;
+        for (int64_t j = 0; j < k; j++) {
+            const U *t = succ + (size_t)j * W;
+            HASH_SLOT();
+            for (int64_t b = 0; b < width; b++) tb[b] = (uint8_t)(t[b >> 3] >> (8 * (b & 7)));
+            int32_t got = -1;
+            U step = 1;
+            for (;; step++) {
+                int32_t g = table[slot];
+                if (g < 0) break;
+                if (memcmp(keys + (size_t)g * (size_t)width, tb, (size_t)width) == 0) { got = g; break; }
+                slot = (slot + step) & tmask;
+            }
+            if (got < 0) {                 /* not stored: a candidate, -1 - its number */
+                U ls = hh & lmask;
+                for (U lstep = 1;; lstep++) {
+                    int32_t c = ltable[ls];
+                    if (c < 0) {
+                        c = (int32_t)nc++; ltable[ls] = c;
+                        memcpy(crow + (size_t)c * (size_t)width, tb, (size_t)width);
+                        cpar[c] = (int32_t)i; cslot[c] = (int64_t)slot; cstep[c] = (int64_t)step;
+                        clocal[c] = (int32_t)ls;
+                    } else if (memcmp(crow + (size_t)c * (size_t)width, tb, (size_t)width) != 0) {
+                        ls = (ls + lstep) & lmask;
+                        continue;
+                    }
+                    got = -1 - c;
+                    break;
+                }
+            }
+            ev[ne] = got; er[ne] = (RULE_T)sr[j]; ne++;
+        }
+        degree[i] = (uint16_t)k;
+    }
+    r->done = i; r->edges = ne; r->distinct = nc;
+}
+int64_t pmerge(int64_t nc, const uint8_t *crow, const int32_t *cpar, const int64_t *cslot, const int64_t *cstep,
+               int32_t *cmap, uint8_t *keys, int64_t nk, int64_t width, int32_t *parent, int32_t *table,
+               int64_t tbits) {
+    U tmask = ((U)1 << tbits) - 1;
+    for (int64_t c = 0; c < nc; c++) {
+        const uint8_t *tb = crow + (size_t)c * (size_t)width;
+        U slot = (U)cslot[c];
+        for (U step = (U)cstep[c];; step++) {
+            int32_t g = table[slot];
+            if (g < 0) {
+                table[slot] = cmap[c] = (int32_t)nk;
+                memcpy(keys + (size_t)nk * (size_t)width, tb, (size_t)width);
+                parent[nk++] = cpar[c];
+                break;
+            }
+            if (memcmp(keys + (size_t)g * (size_t)width, tb, (size_t)width) == 0) { cmap[c] = g; break; }
+            slot = (slot + step) & tmask;
+        }
+    }
+    return nk;
+}
+void pfix(int64_t ne, const int32_t *ev, const RULE_T *er, const int32_t *cmap, int64_t nc, const int32_t *clocal,
+          int32_t *ltable, int32_t *dst, RULE_T *rules) {
+    for (int64_t e = 0; e < ne; e++) {
+        int32_t v = ev[e];
+        dst[e] = v >= 0 ? v : cmap[-1 - v];
+        rules[e] = er[e];
+    }
+    for (int64_t c = 0; c < nc; c++) ltable[clocal[c]] = -1;     /* the thread's table, empty again */
+}"""
+
+
 class _Src:
     """The C text of one model, from its variables' bit fields (compile.Layout)."""
 
@@ -437,6 +528,7 @@ void rehash(const uint8_t *keys, int64_t n, int64_t width, int32_t *table, int64
         table[slot] = (int32_t)i;
     }}
 }}""")
+        out.append(_PARALLEL.replace("RULE_T", rule_t).replace("HIT_FULL", str(HIT_FULL)))
         return out
 
 

@@ -1,174 +1,143 @@
-"""Breadth-first safety search on several cores with a partitioned visited set (issue 12, item 4).
+"""The compiled breadth-first search on several threads over one store (issue 12, item 4).
 
-As in SPIN's multi-core mode and TLC's workers, every state has an owner: worker
-`mix64(state) % workers`. A worker keeps the visited set of its own states only
-(storage.StateStore used as a bare set: keys and hash table, no graph), expands the
-new states it owns with the generated `edges` function, and sends each successor to
-its owner. The layers are synchronised: the coordinating process relays the
-successor batches (as opaque pickled bytes) once every worker has finished a
-layer, so layer k of every worker holds exactly the states at distance k. The
-union of the layers, the edges expanded, the depth and the rule coverage are
-therefore those of the sequential search, and so is the verdict: every state is
-checked against the invariants and for deadlock when it is expanded, in both.
+As TLC's workers do, the threads share one visited set (the store's hash table,
+storage.StateStore) and split the layer being expanded; unlike a partition of the
+states by hash (SPIN's multi-core), this needs no exchange of successors between
+workers, and the search writes the same store as the sequential `bfs`
+(model_check.native), so responses, final checks and counterexamples run on it
+unchanged. A layer goes in rounds, each of three steps in C (native.py `_PARALLEL`):
 
-What it does not do: the response bounds and weak-fairness checks, and the models'
-final-state checks, need the stored graph (model_check.engine); a parallel run
-reports them as not checked. A violation's shortest trace is recomputed by the
-sequential search, which stops at the same layer.
+1. every thread expands its consecutive slice of the round's states against the table as
+   it is (read only): an edge to a stored state gets its id; a successor not stored becomes
+   a candidate of that thread, deduplicated in the thread's own table;
+2. one thread puts the candidates into the shared table, slice after slice, each from where
+   its probe stopped: new states get ids in first-seen order, their parent is the source of
+   their first edge (the slices are consecutive, so their edges are in the sequential order);
+3. every thread turns its edges' candidate numbers into ids and copies them to their place.
+
+So ids, parents, edges, degrees and even the hash table are the sequential search's, byte for
+byte (tests/model_check/test_parallel.py compares the stores), and so are the counts, bounds,
+verdicts and traces. ctypes lets go of the GIL in each call, so the C steps run on both cores;
+step 2 is serial (one probe and one row copy per new state: about a third of the edges).
 """
 from __future__ import annotations
 
-import multiprocessing as mp
-import pickle
-import resource
-import time
-from dataclasses import dataclass
+import ctypes
+from concurrent.futures import ThreadPoolExecutor
+from typing import Callable
 
 import numpy as np
 
-from model_check.compile import Compiled, RangeError, compile_model
-from model_check.engine import SLICE, Progress, Result, explore
-from model_check.native import HIT_RANGE, Native
+from model_check.compile import RangeError
 from model_check.gcl import Model
-from model_check.storage import Meter, StateStore, mix64
+from model_check.native import HIT_FULL, HIT_NONE, HIT_RANGE, Native, range_message, _hit, _Res
+from model_check.storage import LOAD, StateStore
+
+EDGES = 1 << 17          # edges a thread expands in one round at most (its buffers: about 60 bytes each)
 
 
-@dataclass
-class _Layer:
-    """What a worker reports after expanding one layer."""
+class _Slice:
+    """One thread's buffers for a round (reused): its edges and its candidates."""
 
-    new: int                      # states of this layer it owns
-    edges: int                    # transitions it expanded
-    coverage: np.ndarray          # per rule
-    hit: tuple | None             # (kind, index, state) of a violation found, or None
+    def __init__(self, store: StateStore, edges: int):
+        self.ev = np.empty(edges, np.int32)                  # per edge: the id, or -1 - candidate
+        self.er = np.empty(edges, store.rule.data.dtype)     # per edge: the rule
+        self.crow = np.empty((edges, store.width), np.uint8)  # per candidate: the state's row
+        self.cpar = np.empty(edges, np.int32)                 # ... the source of its first edge
+        self.cslot = np.empty(edges, np.int64)                # ... where its probe stopped
+        self.cstep = np.empty(edges, np.int64)
+        self.clocal = np.empty(edges, np.int32)               # ... its slot in `ltable`
+        self.cmap = np.empty(edges, np.int32)                 # ... its id (step 2)
+        self.lbits = (2 * edges - 1).bit_length()
+        self.ltable = np.full(1 << self.lbits, -1, np.int32)
+        self.res = _Res()
+        self.a = self.b = 0                                   # the states of this round
 
-
-def _owners(store: StateStore, states: list[int], workers: int) -> np.ndarray:
-    return (mix64(store.to_words(states)) % np.uint64(workers)).astype(np.int64)
-
-
-def _worker(me: int, workers: int, model: Model, comp: Compiled, conn, nat: Native | None = None) -> None:
-    """One partition: dedup what arrives, expand what is new, ship successors to their owners.
-    States travel as uint64 word rows with the C successor function (`nat`), as ints without."""
-    meter = Meter()
-    rules = len(model.rules)
-    store = StateStore(comp.layout.total_bits, rules)
-    init = store.to_words([comp.init])
-    mine = int((mix64(init) % np.uint64(workers))[0]) == me
-    incoming: list[int] | np.ndarray = (init if mine else init[:0]) if nat else ([comp.init] if mine else [])
-    while True:
-        if nat is None:
-            new: list[int] | np.ndarray = store.add_states(incoming)
-            nxt, rule, ends = [], [], []
-            hit = comp.edges(new, nxt, rule, ends) if new else None
-            edges, cov, out = len(nxt), np.bincount(np.asarray(rule, np.int64), minlength=rules), nxt
-            owner = _owners(store, nxt, workers) if nxt else np.zeros(0, np.int64)
-            buckets = [[nxt[i] for i in np.flatnonzero(owner == j).tolist()] for j in range(workers)]
-        else:
-            new = store.add_rows(incoming)
-            out, edges, cov, hit = _expand_rows(model, nat, new, rules)
-            owner = (mix64(out) % np.uint64(workers)).astype(np.int64)
-            buckets = [out[owner == j] for j in range(workers)]
-        conn.send(_Layer(len(new), edges, cov, hit))
-        for j in range(workers):
-            if j != me:
-                conn.send_bytes(pickle.dumps(buckets[j], pickle.HIGHEST_PROTOCOL))
-        if not conn.recv():                       # the coordinator says stop
-            conn.send((meter.peak(), store.nbytes))
-            conn.close()
-            return
-        parts = [buckets[me]] + [pickle.loads(conn.recv_bytes()) for j in range(workers) if j != me]
-        incoming = np.concatenate(parts) if nat else [s for part in parts for s in part]
+    def ptr(self, name: str) -> ctypes.c_void_p:
+        return ctypes.c_void_p(getattr(self, name).ctypes.data)
 
 
-def _expand_rows(model: Model, nat: Native, new: np.ndarray, rules: int):
-    """A worker's layer on the C successor function: (distinct successors of each call, edges,
-    coverage, hit) -- up to the first violation, like the Python `edges`."""
-    outs, edges, cov, a = [], 0, np.zeros(rules, np.int64), 0
-    while a < len(new):
-        chunk = nat.expand(new[a:a + SLICE])
-        outs.append(chunk.distinct)
-        edges += len(chunk.inv)
-        cov += np.bincount(chunk.rules, minlength=rules)
-        a += chunk.done
-        if chunk.kind == HIT_RANGE:
-            raise RangeError(chunk.range_message(model))
-        if chunk.hit() is not None:
-            return np.concatenate(outs), edges, cov, chunk.hit(int.from_bytes(new[a].astype("<u8").tobytes(), "little"))
-    return (np.concatenate(outs) if outs else new[:0]), edges, cov, None
+def search(model: Model, store: StateStore, lo: int, nat: Native, workers: int,
+           on_layer: Callable[[int, int], None]) -> tuple[tuple | None, int]:
+    """`engine._search_native` on `workers` threads: the search from the layer of ids
+    lo .. len(store)-1 into `store`; (hit, hit id) or (None, -1). `on_layer(first id, width)`
+    is called as each new layer begins."""
+    lib, p, n64 = nat.lib, ctypes.c_void_p, ctypes.c_int64
+    lib.pexpand.restype = lib.pfix.restype = None
+    lib.pmerge.restype = ctypes.c_int64
+    store.rehash = nat.rehash
+    room_min = workers * nat.n_rules             # a round expands at least one state per thread
+    slices = [_Slice(store, EDGES) for _ in range(workers)]
+    fan = nat.n_rules                            # successors per state, for the round's size: the worst at first
+    seen_states = seen_edges = 0
+    i, stop = lo, len(store)
 
+    def expand(s: _Slice) -> None:
+        lib.pexpand(n64(s.a), n64(s.b), p(store.keys.data.ctypes.data), n64(store.width),
+                    p(store.table.ctypes.data), n64(store.table_bits), n64(cap), s.ptr("ev"), s.ptr("er"),
+                    s.ptr("crow"), s.ptr("cpar"), s.ptr("cslot"), s.ptr("cstep"), s.ptr("clocal"), s.ptr("ltable"),
+                    n64(s.lbits), p(store.degree.data.ctypes.data), ctypes.byref(s.res))
 
-def explore_parallel(model: Model, workers: int = 2, compiled: Compiled | None = None,
-                     progress: bool = True) -> Result:
-    """The sequential search's states, transitions, depth, coverage and safety verdict, on
-    `workers` processes (fork: the compiled model is inherited, not pickled)."""
-    comp = compiled or compile_model(model)
-    res = Result(model=model, compiled=comp, coverage=[0] * len(model.rules))
-    if model.responses or model.final_checks:
-        res.warnings.append(f"parallel search ({workers} workers) checks invariants and deadlocks only: "
-                            "responses and final-state checks need the stored graph (run without --workers)")
-    meter = Meter()
-    bar = Progress(model.name) if progress else None
-    t0, c0, ch0 = time.perf_counter(), time.process_time(), _children_cpu()
-    nat = comp.native()            # compiled once, before the fork: every worker inherits it
-    ctx = mp.get_context("fork")
-    conns, procs = [], []
-    for w in range(workers):
-        mine, theirs = ctx.Pipe()
-        p = ctx.Process(target=_worker, args=(w, workers, model, comp, theirs, nat), daemon=True)
-        p.start()
-        theirs.close()
-        conns.append(mine)
-        procs.append(p)
-    cov = np.zeros(len(model.rules), np.int64)
-    layers, hit = 0, None
-    try:
+    def fix(s: _Slice, edge0: int, keep: bool) -> None:
+        ne = int(s.res.edges) if keep else 0    # a slice not kept only empties its table
+        lib.pfix(n64(ne), s.ptr("ev"), s.ptr("er"), s.ptr("cmap"), n64(s.res.distinct), s.ptr("clocal"),
+                 s.ptr("ltable"), p(store.dst.data[edge0:].ctypes.data), p(store.rule.data[edge0:].ctypes.data))
+
+    with ThreadPoolExecutor(workers - 1) as pool:
         while True:
-            reports, batches = [], []
-            for w, conn in enumerate(conns):
-                reports.append(conn.recv())
-                batches.append({j: conn.recv_bytes() for j in range(workers) if j != w})
-            new = sum(r.new for r in reports)
-            res.states += new
-            res.transitions += sum(r.edges for r in reports)
-            cov += sum(r.coverage for r in reports)
-            layers += 1 if new else 0
-            hit = next((r.hit for r in reports if r.hit is not None), None)
-            go = new > 0 and hit is None
-            for j, conn in enumerate(conns):
-                conn.send(go)
-                if go:
-                    for w in range(workers):
-                        if w != j:
-                            conn.send_bytes(batches[w][j])
-            if bar:
-                bar.update(layers - 1, res.states, new)
-            if not go:
-                break
-        finals = [conn.recv() for conn in conns]            # (resident peak, visited-set bytes)
-    finally:
-        for conn in conns:
-            conn.close()
-        for p in procs:
-            p.join(timeout=10)
-            if p.is_alive():                     # pragma: no cover - only after an error above
-                p.terminate()
-    res.depth = max(layers - 1, 0)
-    res.coverage = cov.tolist()
-    res.seconds = time.perf_counter() - t0
-    res.peak_bytes = meter.peak() + sum(peak for peak, _ in finals)   # the coordinator and every worker
-    res.store_bytes = sum(size for _, size in finals)
-    res.cpu = time.process_time() - c0 + _children_cpu() - ch0     # workers: RUSAGE_CHILDREN
-    res.times["search"] = res.cpu
-    if hit is not None:
-        # the sequential search stops in the same layer and gives the shortest trace
-        seq = explore(model, comp, progress=False, check_liveness=False)
-        res.violation = seq.violation
-        res.warnings.append("state and transition counts of a failing parallel run cover whole layers: "
-                            "the sequential search stops inside the layer of the first violation")
-    return res
+            if i == stop:                        # the layer is done: the next is the states it found
+                if len(store) == stop:
+                    return None, -1
+                on_layer(stop, len(store) - stop)
+                stop = len(store)
+            if int(LOAD * len(store.table)) - len(store) < room_min:     # type: ignore[arg-type]
+                store.reserve(room_min, 0, 0)    # the table grows (as `bfs`'s caller grows it)
+            cap = min(EDGES, (int(LOAD * len(store.table)) - len(store)) // workers)   # type: ignore[arg-type]
+            per = max(1, min(-(-(stop - i) // workers), cap // fan))
+            for w, s in enumerate(slices):
+                s.a = min(stop, i + w * per)
+                s.b = min(stop, s.a + per)
+            store.degree.reserve(slices[-1].b - store.degree.n)
+            _run(pool, expand, slices)
+            # keep the slices up to the first that stopped early (full buffers or a hit)
+            kept: list[_Slice] = []
+            for s in slices:
+                if s.a == s.b:
+                    break
+                kept.append(s)
+                if s.res.done < s.b:
+                    break
+            cands = sum(int(s.res.distinct) for s in kept)
+            edges = sum(int(s.res.edges) for s in kept)
+            for g in (store.keys, store.parent):
+                g.reserve(cands)
+            for g in (store.dst, store.rule):
+                g.reserve(edges)
+            nk = len(store)
+            for s in kept:
+                nk = lib.pmerge(n64(s.res.distinct), s.ptr("crow"), s.ptr("cpar"), s.ptr("cslot"), s.ptr("cstep"),
+                                s.ptr("cmap"), p(store.keys.data.ctypes.data), n64(nk), n64(store.width),
+                                p(store.parent.data.ctypes.data), p(store.table.ctypes.data), n64(store.table_bits))
+            edge0 = [store.dst.n]
+            for s in kept:
+                edge0.append(edge0[-1] + int(s.res.edges))
+            _run(pool, lambda s: fix(s, edge0[slices.index(s)] if s in kept else 0, s in kept), slices)
+            last = kept[-1].res
+            store.keys.n = store.parent.n = nk
+            store.dst.n = store.rule.n = edge0[-1]
+            store.degree.n = i = int(last.done)
+            seen_states += i - slices[0].a
+            seen_edges += edges
+            fan = max(1, min(nat.n_rules, -(-2 * seen_edges // max(seen_states, 1))))
+            if last.kind == HIT_RANGE:
+                raise RangeError(range_message(model, int(last.rule), int(last.var), int(last.value)))
+            if last.kind not in (HIT_NONE, HIT_FULL):
+                return _hit(int(last.kind), int(last.index), None), i
 
 
-def _children_cpu() -> float:
-    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return ru.ru_utime + ru.ru_stime
+def _run(pool: ThreadPoolExecutor, fn: Callable[[_Slice], None], slices: list[_Slice]) -> None:
+    """fn on every slice at once: the first in this thread, the others on the pool."""
+    futures = [pool.submit(fn, s) for s in slices[1:]]
+    fn(slices[0])
+    for f in futures:
+        f.result()
