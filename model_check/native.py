@@ -228,18 +228,20 @@ out:
 """ % {"bound": L_BOUND, "overflow": L_OVERFLOW, "violation": L_VIOLATION, "fair": L_FAIR_ONLY}
 
 
-# The parallel search's three steps (model_check.parallel), around `bfs`'s hash table and rows.
-# pexpand (one thread per slice of a layer, at once): expand the stored states i .. stop-1 against
-# the table as it is, read only; a successor not in it becomes a candidate, deduplicated in a
-# table of the thread's own, with where its probe of the shared table stopped (slot, step).
-# pmerge (one thread after another, in slice order): the candidates into the shared table, from
-# where their probe stopped: a new state gets the next id, as `bfs` gives it, since the slices
-# are consecutive and a candidate's first edge is its first in the layer. pfix (all threads):
-# each edge's candidate number becomes the id, the edges go to their place in the store.
+# The parallel search's steps (model_check.parallel), around `bfs`'s hash table and rows; every
+# step runs on all threads at once, a slice each (slice t holds states after those of t - 1).
+# pexpand: expand the slice's states against the table as it is, read only; a successor not in it
+# becomes a candidate, deduplicated in the slice's own table, with its hash and where its probe of
+# the shared table stopped (slot, step). pmark: a candidate an earlier slice has too is that
+# slice's (the earliest), the others are new: numbered in first-seen order. pinsert: a new
+# candidate's id is its slice's base (the stored states, plus the new ones of the slices before)
+# plus its number: its row and parent go there and its id into the table, claimed with a
+# compare-and-swap from where its probe stopped (the slots before it stay taken); each edge's
+# candidate becomes its id, the edges go to their place in the store.
 _PARALLEL = """\
 void pexpand(int64_t i, int64_t stop, const uint8_t *keys, int64_t width, const int32_t *table, int64_t tbits,
-             int64_t cap, int32_t *ev, RULE_T *er, uint8_t *crow, int32_t *cpar, int64_t *cslot, int64_t *cstep,
-             int32_t *clocal, int32_t *ltable, int64_t lbits, uint16_t *degree, Res *r) {
+             int64_t cap, int32_t *ev, RULE_T *er, uint8_t *crow, int32_t *cpar, U *chash, int64_t *cslot,
+             int64_t *cstep, int32_t *clocal, int32_t *ltable, int64_t lbits, uint16_t *degree, Res *r) {
     U tmask = ((U)1 << tbits) - 1, lmask = ((U)1 << lbits) - 1, s[W];
     U succ[NRULES * W]; int32_t sr[NRULES];
     uint8_t tb[W * 8];
@@ -271,7 +273,7 @@ void pexpand(int64_t i, int64_t stop, const uint8_t *keys, int64_t width, const 
                     if (c < 0) {
                         c = (int32_t)nc++; ltable[ls] = c;
                         memcpy(crow + (size_t)c * (size_t)width, tb, (size_t)width);
-                        cpar[c] = (int32_t)i; cslot[c] = (int64_t)slot; cstep[c] = (int64_t)step;
+                        cpar[c] = (int32_t)i; chash[c] = hh; cslot[c] = (int64_t)slot; cstep[c] = (int64_t)step;
                         clocal[c] = (int32_t)ls;
                     } else if (memcmp(crow + (size_t)c * (size_t)width, tb, (size_t)width) != 0) {
                         ls = (ls + lstep) & lmask;
@@ -287,35 +289,59 @@ void pexpand(int64_t i, int64_t stop, const uint8_t *keys, int64_t width, const 
     }
     r->done = i; r->edges = ne; r->distinct = nc;
 }
-int64_t pmerge(int64_t nc, const uint8_t *crow, const int32_t *cpar, const int64_t *cslot, const int64_t *cstep,
-               int32_t *cmap, uint8_t *keys, int64_t nk, int64_t width, int32_t *parent, int32_t *table,
-               int64_t tbits) {
-    U tmask = ((U)1 << tbits) - 1;
+/* slice t's candidates: cown the earliest slice that has it, cidx its number there (new: among
+   the new ones of slice t); the number of new ones */
+int64_t pmark(int64_t t, int64_t nc, const uint8_t *crow, const U *chash, int64_t width, int64_t lbits,
+              uint8_t *const *crows, int32_t *const *ltables, int32_t *cown, int32_t *cidx) {
+    U lmask = ((U)1 << lbits) - 1;
+    int64_t fresh = 0;
     for (int64_t c = 0; c < nc; c++) {
         const uint8_t *tb = crow + (size_t)c * (size_t)width;
+        int32_t own = (int32_t)t, at = -1;
+        for (int64_t u = 0; u < t && at < 0; u++) {
+            U ls = chash[c] & lmask;
+            for (U lstep = 1;; lstep++) {
+                int32_t d = ltables[u][ls];
+                if (d < 0) break;
+                if (memcmp(crows[u] + (size_t)d * (size_t)width, tb, (size_t)width) == 0) { own = (int32_t)u; at = d; break; }
+                ls = (ls + lstep) & lmask;
+            }
+        }
+        cown[c] = own;
+        cidx[c] = at >= 0 ? at : (int32_t)fresh++;
+    }
+    return fresh;
+}
+void pinsert(int64_t t, int64_t nc, const uint8_t *crow, const int32_t *cpar, const int64_t *cslot,
+             const int64_t *cstep, const int32_t *cown, const int32_t *cidx, int32_t *const *cidxs,
+             const int64_t *base, uint8_t *keys, int64_t width, int32_t *parent, int32_t *table, int64_t tbits,
+             int64_t ne, const int32_t *ev, const RULE_T *er, const int32_t *clocal, int32_t *ltable,
+             int32_t *dst, RULE_T *rules) {
+    U tmask = ((U)1 << tbits) - 1;
+    for (int64_t c = 0; c < nc; c++) {
+        if (cown[c] != t) continue;
+        int32_t id = (int32_t)(base[t] + cidx[c]);
+        memcpy(keys + (size_t)id * (size_t)width, crow + (size_t)c * (size_t)width, (size_t)width);
+        parent[id] = cpar[c];
         U slot = (U)cslot[c];
         for (U step = (U)cstep[c];; step++) {
-            int32_t g = table[slot];
-            if (g < 0) {
-                table[slot] = cmap[c] = (int32_t)nk;
-                memcpy(keys + (size_t)nk * (size_t)width, tb, (size_t)width);
-                parent[nk++] = cpar[c];
+            int32_t empty = -1;
+            if (__atomic_load_n(&table[slot], __ATOMIC_RELAXED) < 0 &&
+                __atomic_compare_exchange_n(&table[slot], &empty, id, 0, __ATOMIC_RELAXED, __ATOMIC_RELAXED))
                 break;
-            }
-            if (memcmp(keys + (size_t)g * (size_t)width, tb, (size_t)width) == 0) { cmap[c] = g; break; }
             slot = (slot + step) & tmask;
         }
     }
-    return nk;
-}
-void pfix(int64_t ne, const int32_t *ev, const RULE_T *er, const int32_t *cmap, int64_t nc, const int32_t *clocal,
-          int32_t *ltable, int32_t *dst, RULE_T *rules) {
     for (int64_t e = 0; e < ne; e++) {
         int32_t v = ev[e];
-        dst[e] = v >= 0 ? v : cmap[-1 - v];
+        if (v < 0) {
+            int32_t c = -1 - v, u = cown[c];
+            v = (int32_t)(base[u] + (u == t ? cidx[c] : cidxs[u][cidx[c]]));
+        }
+        dst[e] = v;
         rules[e] = er[e];
     }
-    for (int64_t c = 0; c < nc; c++) ltable[clocal[c]] = -1;     /* the thread's table, empty again */
+    for (int64_t c = 0; c < nc; c++) ltable[clocal[c]] = -1;     /* the slice's table, empty again */
 }"""
 
 
