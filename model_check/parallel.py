@@ -106,7 +106,7 @@ def search(model: Model, store: StateStore, lo: int, nat: Native, workers: int,
                 return None, -1
             if int(LOAD * len(store.table)) - len(store) < room_min:     # type: ignore[arg-type]
                 store.reserve(room_min, 0, 0)    # the table grows (as `bfs`'s caller grows it)
-            cap = min(EDGES, (int(LOAD * len(store.table)) - len(store)) // workers)   # type: ignore[arg-type]
+            cap = max(nat.n_rules, min(EDGES, (int(LOAD * len(store.table)) - len(store)) // workers))  # type: ignore
             # a round may run on into the states of the next layer that are stored already; a narrow
             # frontier (the first and last layers) goes to one thread: no hand-over to wait for
             end = len(store)
