@@ -51,6 +51,7 @@ class Result:
     cpu: float = 0.0                           # CPU seconds of the whole check (search and properties)
     proof: bool = True                         # False after a bitstate search: a pass proves nothing
     native: Native | None = None               # the compiled model the search ended on (None: Python)
+    rounds: parallel.Rounds | None = None      # what the threads did (--workers > 1)
 
     @property
     def ok(self) -> bool:
@@ -140,7 +141,9 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
     store = StateStore(comp.layout.total_bits, len(model.rules))
     store.add_initial(comp.init)
     res.layer_starts = [0, 1]
-    hit, hit_id, res.native = _search(model, comp, store, res.layer_starts, bar, res.times, use_native, workers)
+    res.rounds = parallel.Rounds() if workers > 1 else None
+    hit, hit_id, res.native = _search(model, comp, store, res.layer_starts, bar, res.times, use_native, workers,
+                                      res.rounds)
     if workers > 1 and res.native is None:
         res.warnings.append(f"--workers {workers}: no compiled model (no C compiler, or a construct the C "
                             "generator does not translate): searched on one thread")
@@ -173,8 +176,8 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
 
 
 def _search(model: Model, comp: Compiled, store: StateStore, layer_starts: list[int], bar: Progress | None,
-            times: dict[str, float], use_native: bool | None, workers: int = 1
-            ) -> tuple[tuple | None, int, Native | None]:
+            times: dict[str, float], use_native: bool | None, workers: int = 1,
+            rounds: parallel.Rounds | None = None) -> tuple[tuple | None, int, Native | None]:
     """Breadth-first layers; (hit, id of the hit state, the compiled model used or None), hit None
     and id -1 when there is none.
 
@@ -194,9 +197,10 @@ def _search(model: Model, comp: Compiled, store: StateStore, layer_starts: list[
             times["compile"] = times.get("compile", 0.0) + _cpu() - before
             # explore takes this off the search
             times["compile, in process"] = times.get("compile, in process", 0.0) + time.process_time() - own
-        if nat is not None and workers > 1:
+        if nat is not None and rounds is not None:
             return (*parallel.search(model, store, lo, nat, workers,
-                                     lambda first, width: _next_layer(store, layer_starts, bar, first, width)), nat)
+                                     lambda first, width: _next_layer(store, layer_starts, bar, first, width),
+                                     rounds), nat)
         if nat is not None:           # breadth-first order is id order: the layer is ids lo .. len-1
             return (*_search_native(model, store, lo, nat, layer_starts, bar), nat)
         hi = len(store)

@@ -228,27 +228,55 @@ out:
 """ % {"bound": L_BOUND, "overflow": L_OVERFLOW, "violation": L_VIOLATION, "fair": L_FAIR_ONLY}
 
 
-# The parallel search's steps (model_check.parallel), around `bfs`'s hash table and rows; every
-# step runs on all threads at once, a slice each (slice t holds states after those of t - 1).
-# pexpand: expand the slice's states against the table as it is, read only; a successor not in it
-# becomes a candidate, deduplicated in the slice's own table, with its hash and where its probe of
-# the shared table stopped (slot, step). pmark: a candidate an earlier slice has too is that
-# slice's (the earliest), the others are new: numbered in first-seen order. pinsert: a new
-# candidate's id is its slice's base (the stored states, plus the new ones of the slices before)
-# plus its number: its row and parent go there and its id into the table, claimed with a
-# compare-and-swap from where its probe stopped (the slots before it stay taken); each edge's
-# candidate becomes its id, the edges go to their place in the store.
+# The parallel search (model_check.parallel): `prun`, called on every thread at once (thread t),
+# runs rounds over `bfs`'s hash table and rows until the search ends, a hit, `rounds` rounds, or
+# arrays to grow; threads meet at barriers in C (no Python between the steps). A round: thread 0
+# cuts the next states into consecutive slices, one per thread; then each thread
+# - expands its slice against the table as it is, read only; a successor not in it becomes a
+#   candidate, deduplicated in the slice's own table, with its hash and where its probe of the
+#   shared table stopped (slot, step);
+# - (kept if every slice before it finished) marks its candidates: one an earlier slice has too is
+#   that slice's (the earliest), the others are new, numbered in first-seen order;
+# - (thread 0: each slice's base id is the stored states plus the new ones of the slices before)
+#   writes each new candidate's row and parent at base + number and claims a table slot for its
+#   id with a compare-and-swap from where its probe stopped (the slots before it stay taken), and
+#   its edges, each candidate turned into its id, at their place in the store.
 _PARALLEL = """\
-void pexpand(int64_t i, int64_t stop, const uint8_t *keys, int64_t width, const int32_t *table, int64_t tbits,
-             int64_t cap, int32_t *ev, RULE_T *er, uint8_t *crow, int32_t *cpar, U *chash, int64_t *cslot,
-             int64_t *cstep, int32_t *clocal, int32_t *ltable, int64_t lbits, uint16_t *degree, Res *r) {
-    U tmask = ((U)1 << tbits) - 1, lmask = ((U)1 << lbits) - 1, s[W];
+#include <sched.h>
+typedef struct {
+    int32_t *ev; RULE_T *er; uint8_t *crow; int32_t *cpar; U *chash; int64_t *cslot, *cstep;
+    int32_t *clocal, *ltable, *cown, *cidx;
+    int64_t lbits, a, b, edge0, fresh, base, kept;
+    Res r;
+} Slice;
+typedef struct {
+    uint8_t *keys; int32_t *parent, *table, *dst; RULE_T *rules; uint16_t *degree;
+    int64_t width, tbits, tlimit, kcap, ecap, dcap, nk, ne, i, workers, edges_max, narrow, fan,
+            seen_states, seen_edges, rounds, status, cap, bcount, bsense, nrounds, nsplit, ndropped;
+    Res hit;
+} Ctx;
+enum { P_RUN, P_DONE, P_PAUSE, P_GROW, P_HIT };
+static void pbarrier(Ctx *c, int64_t *sense) {
+    int64_t s = !*sense;
+    *sense = s;
+    if (__atomic_add_fetch(&c->bcount, 1, __ATOMIC_ACQ_REL) == c->workers) {
+        __atomic_store_n(&c->bcount, 0, __ATOMIC_RELAXED);
+        __atomic_store_n(&c->bsense, s, __ATOMIC_RELEASE);
+    } else
+        for (int k = 0; __atomic_load_n(&c->bsense, __ATOMIC_ACQUIRE) != s; k++)
+            if (k > 100) sched_yield();
+}
+static void pexpand(const Ctx *c, Slice *q) {
+    int64_t tbits = c->tbits;
+    U tmask = ((U)1 << tbits) - 1, lmask = ((U)1 << q->lbits) - 1, s[W];
     U succ[NRULES * W]; int32_t sr[NRULES];
     uint8_t tb[W * 8];
-    int64_t ne = 0, nc = 0;
+    const uint8_t *keys = c->keys;
+    int64_t width = c->width, ne = 0, nc = 0, i = q->a;
+    Res *r = &q->r;
     r->kind = 0;
-    for (; i < stop; i++) {
-        if (ne + NRULES > cap) { r->kind = HIT_FULL; break; }
+    for (; i < q->b; i++) {
+        if (ne + NRULES > c->cap) { r->kind = HIT_FULL; break; }
         const uint8_t *row = keys + (size_t)i * (size_t)width;
         memset(s, 0, sizeof s);
         for (int64_t j = 0; j < width; j++) s[j >> 3] |= (U)row[j] << (8 * (j & 7));
@@ -261,7 +289,7 @@ void pexpand(int64_t i, int64_t stop, const uint8_t *keys, int64_t width, const 
             int32_t got = -1;
             U step = 1;
             for (;; step++) {
-                int32_t g = table[slot];
+                int32_t g = c->table[slot];
                 if (g < 0) break;
                 if (memcmp(keys + (size_t)g * (size_t)width, tb, (size_t)width) == 0) { got = g; break; }
                 slot = (slot + step) & tmask;
@@ -269,79 +297,140 @@ void pexpand(int64_t i, int64_t stop, const uint8_t *keys, int64_t width, const 
             if (got < 0) {                 /* not stored: a candidate, -1 - its number */
                 U ls = hh & lmask;
                 for (U lstep = 1;; lstep++) {
-                    int32_t c = ltable[ls];
-                    if (c < 0) {
-                        c = (int32_t)nc++; ltable[ls] = c;
-                        memcpy(crow + (size_t)c * (size_t)width, tb, (size_t)width);
-                        cpar[c] = (int32_t)i; chash[c] = hh; cslot[c] = (int64_t)slot; cstep[c] = (int64_t)step;
-                        clocal[c] = (int32_t)ls;
-                    } else if (memcmp(crow + (size_t)c * (size_t)width, tb, (size_t)width) != 0) {
+                    int32_t d = q->ltable[ls];
+                    if (d < 0) {
+                        d = (int32_t)nc++; q->ltable[ls] = d;
+                        memcpy(q->crow + (size_t)d * (size_t)width, tb, (size_t)width);
+                        q->cpar[d] = (int32_t)i; q->chash[d] = hh; q->cslot[d] = (int64_t)slot;
+                        q->cstep[d] = (int64_t)step; q->clocal[d] = (int32_t)ls;
+                    } else if (memcmp(q->crow + (size_t)d * (size_t)width, tb, (size_t)width) != 0) {
                         ls = (ls + lstep) & lmask;
                         continue;
                     }
-                    got = -1 - c;
+                    got = -1 - d;
                     break;
                 }
             }
-            ev[ne] = got; er[ne] = (RULE_T)sr[j]; ne++;
+            q->ev[ne] = got; q->er[ne] = (RULE_T)sr[j]; ne++;
         }
-        degree[i] = (uint16_t)k;
+        c->degree[i] = (uint16_t)k;
     }
     r->done = i; r->edges = ne; r->distinct = nc;
 }
 /* slice t's candidates: cown the earliest slice that has it, cidx its number there (new: among
    the new ones of slice t); the number of new ones */
-int64_t pmark(int64_t t, int64_t nc, const uint8_t *crow, const U *chash, int64_t width, int64_t lbits,
-              uint8_t *const *crows, int32_t *const *ltables, int32_t *cown, int32_t *cidx) {
-    U lmask = ((U)1 << lbits) - 1;
-    int64_t fresh = 0;
-    for (int64_t c = 0; c < nc; c++) {
-        const uint8_t *tb = crow + (size_t)c * (size_t)width;
+static int64_t pmark(const Ctx *c, Slice *sl, int64_t t) {
+    Slice *q = &sl[t];
+    U lmask = ((U)1 << q->lbits) - 1;
+    int64_t fresh = 0, width = c->width;
+    for (int64_t d = 0; d < q->r.distinct; d++) {
+        const uint8_t *tb = q->crow + (size_t)d * (size_t)width;
         int32_t own = (int32_t)t, at = -1;
         for (int64_t u = 0; u < t && at < 0; u++) {
-            U ls = chash[c] & lmask;
+            U ls = q->chash[d] & lmask;
             for (U lstep = 1;; lstep++) {
-                int32_t d = ltables[u][ls];
-                if (d < 0) break;
-                if (memcmp(crows[u] + (size_t)d * (size_t)width, tb, (size_t)width) == 0) { own = (int32_t)u; at = d; break; }
+                int32_t e = sl[u].ltable[ls];
+                if (e < 0) break;
+                if (memcmp(sl[u].crow + (size_t)e * (size_t)width, tb, (size_t)width) == 0) { own = (int32_t)u; at = e; break; }
                 ls = (ls + lstep) & lmask;
             }
         }
-        cown[c] = own;
-        cidx[c] = at >= 0 ? at : (int32_t)fresh++;
+        q->cown[d] = own;
+        q->cidx[d] = at >= 0 ? at : (int32_t)fresh++;
     }
     return fresh;
 }
-void pinsert(int64_t t, int64_t nc, const uint8_t *crow, const int32_t *cpar, const int64_t *cslot,
-             const int64_t *cstep, const int32_t *cown, const int32_t *cidx, int32_t *const *cidxs,
-             const int64_t *base, uint8_t *keys, int64_t width, int32_t *parent, int32_t *table, int64_t tbits,
-             int64_t ne, const int32_t *ev, const RULE_T *er, const int32_t *clocal, int32_t *ltable,
-             int32_t *dst, RULE_T *rules) {
-    U tmask = ((U)1 << tbits) - 1;
-    for (int64_t c = 0; c < nc; c++) {
-        if (cown[c] != t) continue;
-        int32_t id = (int32_t)(base[t] + cidx[c]);
-        memcpy(keys + (size_t)id * (size_t)width, crow + (size_t)c * (size_t)width, (size_t)width);
-        parent[id] = cpar[c];
-        U slot = (U)cslot[c];
-        for (U step = (U)cstep[c];; step++) {
+static void pinsert(const Ctx *c, Slice *sl, int64_t t) {
+    Slice *q = &sl[t];
+    U tmask = ((U)1 << c->tbits) - 1;
+    int64_t width = c->width;
+    for (int64_t d = 0; d < q->r.distinct; d++) {
+        if (q->cown[d] != t) continue;
+        int32_t id = (int32_t)(q->base + q->cidx[d]);
+        memcpy(c->keys + (size_t)id * (size_t)width, q->crow + (size_t)d * (size_t)width, (size_t)width);
+        c->parent[id] = q->cpar[d];
+        U slot = (U)q->cslot[d];
+        for (U step = (U)q->cstep[d];; step++) {
             int32_t empty = -1;
-            if (__atomic_load_n(&table[slot], __ATOMIC_RELAXED) < 0 &&
-                __atomic_compare_exchange_n(&table[slot], &empty, id, 0, __ATOMIC_RELAXED, __ATOMIC_RELAXED))
+            if (__atomic_load_n(&c->table[slot], __ATOMIC_RELAXED) < 0 &&
+                __atomic_compare_exchange_n(&c->table[slot], &empty, id, 0, __ATOMIC_RELAXED, __ATOMIC_RELAXED))
                 break;
             slot = (slot + step) & tmask;
         }
     }
-    for (int64_t e = 0; e < ne; e++) {
-        int32_t v = ev[e];
+    int32_t *dst = c->dst + q->edge0;
+    RULE_T *rules = c->rules + q->edge0;
+    for (int64_t e = 0; e < q->r.edges; e++) {
+        int32_t v = q->ev[e];
         if (v < 0) {
-            int32_t c = -1 - v, u = cown[c];
-            v = (int32_t)(base[u] + (u == t ? cidx[c] : cidxs[u][cidx[c]]));
+            int32_t d = -1 - v, u = q->cown[d];
+            v = (int32_t)(u == t ? q->base + q->cidx[d] : sl[u].base + sl[u].cidx[q->cidx[d]]);
         }
         dst[e] = v;
-        rules[e] = er[e];
+        rules[e] = q->er[e];
     }
-    for (int64_t c = 0; c < nc; c++) ltable[clocal[c]] = -1;     /* the slice's table, empty again */
+}
+/* thread 0, before a round: the slices, or why not (the search is over, arrays to grow, a pause) */
+static void pplan(Ctx *c, Slice *sl) {
+    int64_t n = c->workers;
+    if (c->status != P_RUN) return;
+    if (c->i == c->nk) { c->status = P_DONE; return; }
+    if (c->rounds-- <= 0) { c->status = P_PAUSE; return; }
+    int64_t room = c->tlimit - c->nk;            /* states the table takes at its load limit */
+    if (room < n * NRULES) { c->status = P_GROW; return; }
+    int64_t cap = room / n < c->edges_max ? room / n : c->edges_max;
+    if (c->kcap - c->nk < n * cap || c->ecap - c->ne < n * cap) { c->status = P_GROW; return; }
+    int64_t avail = c->nk - c->i;      /* may run on into the next layer's states stored already */
+    int64_t per = avail > c->narrow ? (avail + n - 1) / n : avail;     /* a narrow frontier: one thread */
+    if (per > cap / c->fan) per = cap / c->fan;
+    if (per < 1) per = 1;
+    if (c->dcap < c->i + n * per) { c->status = P_GROW; return; }
+    for (int64_t u = 0; u < n; u++) {
+        sl[u].a = c->i + u * per < c->nk ? c->i + u * per : c->nk;
+        sl[u].b = sl[u].a + per < c->nk ? sl[u].a + per : c->nk;
+    }
+    c->cap = cap;
+}
+/* thread 0, after the marks: bases and edge places of the kept slices, the counts, a hit */
+static void psettle(Ctx *c, Slice *sl) {
+    int64_t nk = c->nk, ne = c->ne, last = 0, busy = 0;
+    for (int64_t u = 0; u < c->workers && sl[u].kept; u++) {
+        sl[u].base = nk; nk += sl[u].fresh;
+        sl[u].edge0 = ne; ne += sl[u].r.edges;
+        last = u;
+    }
+    for (int64_t u = 0; u < c->workers; u++) busy += sl[u].a < sl[u].b;
+    c->nrounds++;
+    c->nsplit += busy > 1;
+    c->ndropped += busy > last + 1;
+    Res *r = &sl[last].r;
+    c->seen_states += r->done - sl[0].a;
+    c->seen_edges += ne - c->ne;
+    c->nk = nk; c->ne = ne; c->i = r->done;
+    int64_t fan = (2 * c->seen_edges + c->seen_states - 1) / (c->seen_states > 0 ? c->seen_states : 1);
+    c->fan = fan < 1 ? 1 : fan > NRULES ? NRULES : fan;
+    if (r->kind != 0 && r->kind != HIT_FULL) { c->hit = *r; c->status = P_HIT; }
+}
+void prun(Ctx *c, Slice *sl, int64_t t) {
+    int64_t sense = 0;
+    Slice *q = &sl[t];
+    for (;;) {
+        if (t == 0) pplan(c, sl);
+        pbarrier(c, &sense);
+        if (c->status != P_RUN) return;
+        pexpand(c, q);
+        pbarrier(c, &sense);
+        q->kept = q->a < q->b;
+        for (int64_t u = 0; u < t; u++) if (sl[u].r.done < sl[u].b) q->kept = 0;
+        q->fresh = q->kept ? pmark(c, sl, t) : 0;
+        pbarrier(c, &sense);
+        if (t == 0) psettle(c, sl);
+        pbarrier(c, &sense);
+        if (q->kept) pinsert(c, sl, t);
+        for (int64_t d = 0; d < q->r.distinct; d++) q->ltable[q->clocal[d]] = -1;   /* empty again */
+        q->r.distinct = 0;
+        if (!q->kept) q->r.edges = 0;
+    }
 }"""
 
 
