@@ -252,7 +252,7 @@ typedef struct {
 typedef struct {
     uint8_t *keys; int32_t *parent, *table, *dst; RULE_T *rules; uint16_t *degree;
     int64_t width, tbits, tlimit, kcap, ecap, dcap, nk, ne, i, workers, edges_max, narrow, fan,
-            seen_states, seen_edges, slack, rounds, status, cap, bcount, bsense, nrounds, nsplit, ndropped;
+            seen_states, seen_edges, rounds, status, cap, bcount, bsense, nrounds, nsplit, ndropped;
     Res hit;
 } Ctx;
 enum { P_RUN, P_DONE, P_PAUSE, P_GROW, P_HIT };
@@ -407,11 +407,15 @@ static void psettle(Ctx *c, Slice *sl) {
     c->seen_states += r->done - sl[0].a;
     c->seen_edges += ne - c->ne;
     c->nk = nk; c->ne = ne; c->i = r->done;
-    /* successors per state to plan for: twice the mean so far, doubled after a round that dropped slices */
-    int64_t fan = (2 * c->seen_edges + c->seen_states - 1) / (c->seen_states > 0 ? c->seen_states : 1);
-    if (busy > last + 1) c->slack = c->slack * 2 < NRULES ? c->slack * 2 : NRULES;
-    fan *= c->slack;
-    c->fan = fan < 1 ? 1 : fan > NRULES ? NRULES : fan;
+    /* successors per state to plan for: twice the highest mean of this round's slices; after a
+       round that dropped slices, twice what was planned */
+    int64_t fan = 1;
+    for (int64_t u = 0; u <= last; u++) {
+        int64_t m = sl[u].r.done > sl[u].a ? (2 * sl[u].r.edges + sl[u].r.done - sl[u].a - 1) / (sl[u].r.done - sl[u].a) : 1;
+        if (m > fan) fan = m;
+    }
+    if (busy > last + 1) fan = 2 * c->fan;
+    c->fan = fan > NRULES ? NRULES : fan;
     if (r->kind != 0 && r->kind != HIT_FULL) { c->hit = *r; c->status = P_HIT; }
 }
 void prun(Ctx *c, Slice *sl, int64_t t) {

@@ -61,7 +61,7 @@ class _Ctx(ctypes.Structure):
     _fields_ = ([(f, ctypes.c_void_p) for f in ("keys", "parent", "table", "dst", "rules", "degree")]
                 + [(f, ctypes.c_int64) for f in ("width", "tbits", "tlimit", "kcap", "ecap", "dcap", "nk", "ne", "i",
                                                   "workers", "edges_max", "narrow", "fan", "seen_states",
-                                                  "seen_edges", "slack", "rounds", "status", "cap", "bcount", "bsense", "nrounds",
+                                                  "seen_edges", "rounds", "status", "cap", "bcount", "bsense", "nrounds",
                                                   "nsplit", "ndropped")]
                 + [("hit", _Res)])
 
@@ -99,8 +99,7 @@ def search(model: Model, store: StateStore, lo: int, nat: Native, workers: int,
     edges = max(EDGES, nat.n_rules)              # room for one state's successors at least
     csl = (_CSlice * workers)()
     slices = [_Slice(store, edges, csl[t]) for t in range(workers)]      # noqa: F841 - the buffers C uses
-    ctx = _Ctx(workers=workers, width=store.width, edges_max=edges, narrow=NARROW, fan=nat.n_rules, slack=1,
-               i=lo)
+    ctx = _Ctx(workers=workers, width=store.width, edges_max=edges, narrow=NARROW, fan=nat.n_rules, i=lo)
     stop = len(store)
     room = workers * nat.n_rules
     with ThreadPoolExecutor(workers - 1) as pool:
