@@ -1,24 +1,29 @@
 """The compiled breadth-first search on several threads over one store (issue 12, item 4).
 
 As TLC's workers do, the threads share one visited set (the store's hash table,
-storage.StateStore) and split the layer being expanded; unlike a partition of the
-states by hash (SPIN's multi-core), this needs no exchange of successors between
-workers, and the search writes the same store as the sequential `bfs`
-(model_check.native), so responses, final checks and counterexamples run on it
-unchanged. A layer goes in rounds, each of three steps in C (native.py `_PARALLEL`):
+storage.StateStore) and split the states to expand; unlike a partition of the states
+by hash (SPIN's multi-core), no successors travel between workers, and the search
+writes the same store as the one-thread `bfs` (model_check.native), so responses,
+final checks and counterexamples run on it unchanged. The search goes in rounds, all
+in C (native.py `prun`, called on every thread; the threads meet at barriers in C):
 
-1. every thread expands its consecutive slice of the round's states against the table as
-   it is (read only): an edge to a stored state gets its id; a successor not stored becomes
-   a candidate of that thread, deduplicated in the thread's own table;
-2. one thread puts the candidates into the shared table, slice after slice, each from where
-   its probe stopped: new states get ids in first-seen order, their parent is the source of
-   their first edge (the slices are consecutive, so their edges are in the sequential order);
-3. every thread turns its edges' candidate numbers into ids and copies them to their place.
+1. thread 0 cuts the next stored states (they may run on into the next layer) into
+   consecutive slices, one per thread;
+2. every thread expands its slice against the table as it is (read only): an edge to a
+   stored state gets its id; a successor not stored becomes a candidate of the slice,
+   deduplicated in the slice's own table;
+3. a candidate an earlier slice has too is that slice's; the others are new, numbered in
+   first-seen order;
+4. each slice's new states get ids after the stored states and the new ones of the slices
+   before it, so ids, parents (the source of a state's first edge) and edges are those of
+   the one-thread search; rows, parents, table slots (compare-and-swap) and edges are
+   written by all threads at once.
 
-So ids, parents, edges, degrees and even the hash table are the sequential search's, byte for
-byte (tests/model_check/test_parallel.py compares the stores), and so are the counts, bounds,
-verdicts and traces. ctypes lets go of the GIL in each call, so the C steps run on both cores;
-step 2 is serial (one probe and one row copy per new state: about a third of the edges).
+A slice that fills its buffers (or holds a hit) ends the round there: the slices after it
+are expanded again in the next round. Only the hash table's slot order may differ from the
+one-thread search's (it is dropped after the search); tests/model_check/test_parallel.py
+compares everything else. Python sees the search every ROUNDS rounds (progress), at its
+end, at a hit, and to grow the arrays.
 """
 from __future__ import annotations
 
