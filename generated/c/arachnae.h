@@ -480,6 +480,13 @@ arachnae_status arachnae_frame_check(const uint8_t *frame, uint16_t len, uint16_
  * frame cut short and re-arms the parser. Call feed() and gap() from contexts
  * that do not preempt each other. The CRC runs once, over the whole frame, in the
  * feed() of its last byte: the bus is quiet for the idle gap after it. */
+/* Parser states (the generic parser's and each role's, node_<role>.h); READY and HELD, the two with a
+ * valid frame, are the highest (one compare in the frame() accessors). */
+#define ARACHNAE_PS_RECEIVING 0u  /* the initial state */
+#define ARACHNAE_PS_COMPLETE 1u   /* frame ended where its length byte said; verdict given */
+#define ARACHNAE_PS_DISCARD 2u    /* error reported; ignore bytes until the gap */
+#define ARACHNAE_PS_READY 3u      /* as COMPLETE, and the frame passed every check */
+#define ARACHNAE_PS_HELD 4u       /* READY frame after its gap: kept until the next byte */
 typedef arachnae_status (*arachnae_payload_check_fn)(uint8_t opcode, const uint8_t *payload, uint8_t len);
 
 typedef struct {
@@ -500,10 +507,9 @@ arachnae_status arachnae_parser_feed(arachnae_parser *p, uint8_t byte);
 arachnae_status arachnae_parser_gap(arachnae_parser *p);
 /* The last complete and valid frame (NULL if none since the last gap). Inline: a field read, not
  * worth a call (issue 15). READY and HELD, the parser's two states with a valid frame, are the highest. */
-#define ARACHNAE_PARSER_READY 3u
 static inline const uint8_t *arachnae_parser_frame(const arachnae_parser *p, uint16_t *len)
 {
-    if (p->state < ARACHNAE_PARSER_READY)
+    if (p->state < ARACHNAE_PS_READY)
         return 0;
     *len = p->count;
     return p->buf;

@@ -89,7 +89,7 @@ static inline arachnae_status envelope(const uint8_t *frame, uint16_t len, uint1
     if (arachnae_crc16(frame, len) != 0u)
         return ARACHNAE_CHECKSUM;
     /* ADDRESS: for another node. ROUTE (seed 3.2.1): not from a node, or to broadcast with a message the
-     * spec does not mark broadcast, or (own = any) to no node; `own` itself is a node (the skeleton's init) */
+     * spec does not mark broadcast */
     dst = frame[ARACHNAE_FRAME_DST];
     if (dst == ARACHNAE_ADDR_BROADCAST) {
         if (!arachnae_may_broadcast(frame[ARACHNAE_FRAME_OPCODE]))
@@ -97,7 +97,7 @@ static inline arachnae_status envelope(const uint8_t *frame, uint16_t len, uint1
     } else if (own_hi == 0u) {  /* not ARACHNAE_ANY_ADDRESS: its high byte alone says so (8-bit compares, flash) */
         if (dst != own_lo)
             return ARACHNAE_ADDRESS;
-    } else if (!arachnae_is_node(dst)) {
+    } else if (!arachnae_is_node(dst)) {  /* own = any: to no node is ROUTE; `own` itself is a node (the skeleton's init) */
         return ARACHNAE_ROUTE;
     }
     if (!arachnae_is_node(frame[ARACHNAE_FRAME_SRC]))
@@ -118,15 +118,6 @@ arachnae_status arachnae_frame_check(const uint8_t *frame, uint16_t len, uint16_
     return envelope(frame, len, own);
 }
 
-/* parser states; READY and HELD, the two with a valid frame, are the highest (one compare,
- * arachnae_parser_frame() in arachnae.h) */
-#define PS_RECEIVING 0u  /* ARACHNAE_PARSER_INIT's state */
-#define PS_COMPLETE 1u  /* frame ended where its length byte said; verdict given */
-#define PS_DISCARD 2u   /* error reported; ignore bytes until the gap */
-#define PS_READY ARACHNAE_PARSER_READY     /* as COMPLETE, and the frame passed every check */
-#define PS_HELD 4u      /* READY frame after its gap: kept until the next byte */
-typedef char arachnae_parser_states_ok[(PS_HELD > PS_READY && PS_READY > PS_DISCARD) ? 1 : -1];
-
 void arachnae_parser_init(arachnae_parser *p, uint8_t *buf, uint16_t cap, uint16_t own,
                           arachnae_payload_check_fn check)
 {
@@ -135,56 +126,55 @@ void arachnae_parser_init(arachnae_parser *p, uint8_t *buf, uint16_t cap, uint16
     p->own = own;
     p->check = check;
     p->count = 0;
-    p->state = PS_RECEIVING;
+    p->state = ARACHNAE_PS_RECEIVING;
 }
 
 arachnae_status arachnae_parser_feed(arachnae_parser *p, uint8_t byte)
 {
-    uint16_t n, need;
+    uint16_t n;
     arachnae_status st;
-    if (p->state != PS_RECEIVING) {
-        if (p->state == PS_DISCARD)
+    if (p->state != ARACHNAE_PS_RECEIVING) {
+        if (p->state == ARACHNAE_PS_DISCARD)
             return ARACHNAE_NONE;
-        if (p->state != PS_HELD) {
+        if (p->state != ARACHNAE_PS_HELD) {
             /* COMPLETE or READY: more bytes than the length byte said */
-            p->state = PS_DISCARD;
+            p->state = ARACHNAE_PS_DISCARD;
             return ARACHNAE_OVERSIZE;
         }
-        p->state = PS_RECEIVING;
+        p->state = ARACHNAE_PS_RECEIVING;
         p->count = 0;
     }
     n = p->count;
     if (n >= p->cap) {
-        p->state = PS_DISCARD;
+        p->state = ARACHNAE_PS_DISCARD;
         return ARACHNAE_OVERSIZE;
     }
     p->buf[n] = byte;
     p->count = ++n;
     if (n <= ARACHNAE_FRAME_LENGTH)
         return ARACHNAE_NONE;
-    need = (uint16_t)(ARACHNAE_FRAME_OVERHEAD + p->buf[ARACHNAE_FRAME_LENGTH]);
-    if (need > p->cap) {  /* known as soon as the length byte is in */
-        p->state = PS_DISCARD;
+    if ((uint16_t)(ARACHNAE_FRAME_OVERHEAD + p->buf[ARACHNAE_FRAME_LENGTH]) > p->cap) {  /* known as soon as the length byte is in */
+        p->state = ARACHNAE_PS_DISCARD;
         return ARACHNAE_OVERSIZE;
     }
-    if (n != need)
+    if (n != (uint16_t)(ARACHNAE_FRAME_OVERHEAD + p->buf[ARACHNAE_FRAME_LENGTH]))
         return ARACHNAE_NONE;
     /* The whole frame is in: the CRC runs over it here, once. The next byte of the bus
      * comes only after the idle gap, so this loop (6 to 261 bytes) delays no byte. */
-    st = envelope(p->buf, n, p->own);   /* n == need: the length is right */
+    st = envelope(p->buf, n, p->own);   /* n agrees with the length byte */
     if (st == ARACHNAE_OK && p->check != 0)
         st = p->check(p->buf[ARACHNAE_FRAME_OPCODE], p->buf + ARACHNAE_FRAME_PAYLOAD, p->buf[ARACHNAE_FRAME_LENGTH]);
-    p->state = (st == ARACHNAE_OK) ? PS_READY : PS_COMPLETE;
+    p->state = (st == ARACHNAE_OK) ? ARACHNAE_PS_READY : ARACHNAE_PS_COMPLETE;
     return st;
 }
 
 arachnae_status arachnae_parser_gap(arachnae_parser *p)
 {
-    arachnae_status st = (p->state == PS_RECEIVING && p->count > 0u) ? ARACHNAE_TRUNCATED : ARACHNAE_NONE;
-    if (p->state == PS_READY) {
-        p->state = PS_HELD;  /* keeps buf and count for arachnae_parser_frame() */
+    arachnae_status st = (p->state == ARACHNAE_PS_RECEIVING && p->count > 0u) ? ARACHNAE_TRUNCATED : ARACHNAE_NONE;
+    if (p->state == ARACHNAE_PS_READY) {
+        p->state = ARACHNAE_PS_HELD;  /* keeps buf and count for the frame() accessor */
     } else {
-        p->state = PS_RECEIVING;
+        p->state = ARACHNAE_PS_RECEIVING;
         p->count = 0;
     }
     return st;

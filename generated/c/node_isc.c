@@ -29,6 +29,82 @@ arachnae_status isc_payload_check(uint8_t opcode, const uint8_t *payload, uint8_
     }
 }
 
+/* the envelope check of the role's parser: arachnae_frame_check's for own = this node */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline arachnae_status envelope(const isc_rx *p, const uint8_t *frame, uint16_t len)
+{
+    uint8_t dst;
+    (void)p;
+    /* MSB-first CRC without xorout: over a good frame with its big-endian CRC it gives 0 */
+    if (arachnae_crc16(frame, len) != 0u)
+        return ARACHNAE_CHECKSUM;
+    /* ADDRESS: for another node. ROUTE (seed 3.2.1): not from a node, or to broadcast with a message the
+     * spec does not mark broadcast */
+    dst = frame[ARACHNAE_FRAME_DST];
+    if (dst == ARACHNAE_ADDR_BROADCAST) {
+        if (!arachnae_may_broadcast(frame[ARACHNAE_FRAME_OPCODE]))
+            return ARACHNAE_ROUTE;
+    } else if (dst != 0x2Au) {
+        return ARACHNAE_ADDRESS;
+    }
+    if (!arachnae_is_node(frame[ARACHNAE_FRAME_SRC]))
+        return ARACHNAE_ROUTE;
+    return ARACHNAE_OK;
+}
+
+arachnae_status isc_rx_feed(isc_rx *p, uint8_t byte)
+{
+    uint8_t n;
+    arachnae_status st;
+    if (p->state != ARACHNAE_PS_RECEIVING) {
+        if (p->state == ARACHNAE_PS_DISCARD)
+            return ARACHNAE_NONE;
+        if (p->state != ARACHNAE_PS_HELD) {
+            /* COMPLETE or READY: more bytes than the length byte said */
+            p->state = ARACHNAE_PS_DISCARD;
+            return ARACHNAE_OVERSIZE;
+        }
+        p->state = ARACHNAE_PS_RECEIVING;
+        p->count = 0;
+    }
+    n = p->count;
+    if (n >= ARACHNAE_RX_MAX_ISC) {
+        p->state = ARACHNAE_PS_DISCARD;
+        return ARACHNAE_OVERSIZE;
+    }
+    p->buf[n] = byte;
+    p->count = ++n;
+    if (n <= ARACHNAE_FRAME_LENGTH)
+        return ARACHNAE_NONE;
+    if (p->buf[ARACHNAE_FRAME_LENGTH] > 2u) {  /* known as soon as the length byte is in */
+        p->state = ARACHNAE_PS_DISCARD;
+        return ARACHNAE_OVERSIZE;
+    }
+    if (n != (uint8_t)(ARACHNAE_FRAME_OVERHEAD + p->buf[ARACHNAE_FRAME_LENGTH]))
+        return ARACHNAE_NONE;
+    /* The whole frame is in: the CRC runs over it here, once. The next byte of the bus
+     * comes only after the idle gap, so this loop (6 to 261 bytes) delays no byte. */
+    st = envelope(p, p->buf, n);   /* n agrees with the length byte */
+    if (st == ARACHNAE_OK)
+        st = isc_payload_check(p->buf[ARACHNAE_FRAME_OPCODE], p->buf + ARACHNAE_FRAME_PAYLOAD, p->buf[ARACHNAE_FRAME_LENGTH]);
+    p->state = (st == ARACHNAE_OK) ? ARACHNAE_PS_READY : ARACHNAE_PS_COMPLETE;
+    return st;
+}
+
+arachnae_status isc_rx_gap(isc_rx *p)
+{
+    arachnae_status st = (p->state == ARACHNAE_PS_RECEIVING && p->count > 0u) ? ARACHNAE_TRUNCATED : ARACHNAE_NONE;
+    if (p->state == ARACHNAE_PS_READY) {
+        p->state = ARACHNAE_PS_HELD;  /* keeps buf and count for the frame() accessor */
+    } else {
+        p->state = ARACHNAE_PS_RECEIVING;
+        p->count = 0;
+    }
+    return st;
+}
+
 /* A frame the parser passed with own = node->address and isc_payload_check (feed() said OK):
  * envelope and payload are checked once, there, not again here (issue 15). Calls its callback, or
  * builds and sends the reply to a request (one reply buffer, one seal and one send for all of them:

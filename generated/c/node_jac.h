@@ -8,11 +8,32 @@
  * common handling of INIT, ID_REQ, STATUS_REQ.
  * The behaviour is hand-written (firmware/nodes/jac.c) and defines the
  * functions under "defined by the behaviour"; regeneration never touches it.
- * Use: arachnae_parser_init(&parser, buf, ARACHNAE_RX_MAX_JAC, node.address,
- * jac_payload_check) in the UART RX path; when feed() returns ARACHNAE_OK,
- * pass arachnae_parser_frame() (or a copy of it) to jac_dispatch() from the main loop.
+ * Use: static jac_rx rx = JAC_RX_INIT(own address); jac_rx_feed() and
+ * jac_rx_gap() in the UART RX path; when feed() returns ARACHNAE_OK, pass jac_rx_frame()
+ * (or a copy of it) to jac_dispatch() from the main loop.
  */
 #include "arachnae.h"
+
+/* The role's byte parser: arachnae_parser's states and verdicts (arachnae.h), with the role's largest
+ * frame (10 bytes), own address and jac_payload_check built in (issue 15: no
+ * pointers or 16-bit counts to carry where the role does not need them). */
+typedef struct {
+    uint8_t state;
+    uint8_t count;
+    uint8_t own;     /* the node's address, one of the role's */
+    uint8_t buf[ARACHNAE_RX_MAX_JAC];
+} jac_rx;
+#define JAC_RX_INIT(own) { ARACHNAE_PS_RECEIVING, 0u, (own), { 0u } }
+arachnae_status jac_rx_feed(jac_rx *p, uint8_t byte);
+arachnae_status jac_rx_gap(jac_rx *p);
+/* The last complete and valid frame (NULL if none since the last gap), as arachnae_parser_frame(). */
+static inline const uint8_t *jac_rx_frame(const jac_rx *p, uint16_t *len)
+{
+    if (p->state < ARACHNAE_PS_READY)
+        return 0;
+    *len = p->count;
+    return p->buf;
+}
 
 typedef struct jac_node {
     uint8_t address; /* own address */

@@ -8,11 +8,32 @@
  * common handling of INIT, ID_REQ, STATUS_REQ.
  * The behaviour is hand-written (firmware/nodes/lcp.c) and defines the
  * functions under "defined by the behaviour"; regeneration never touches it.
- * Use: arachnae_parser_init(&parser, buf, ARACHNAE_RX_MAX_LCP, node.address,
- * lcp_payload_check) in the UART RX path; when feed() returns ARACHNAE_OK,
- * pass arachnae_parser_frame() (or a copy of it) to lcp_dispatch() from the main loop.
+ * Use: static lcp_rx rx = LCP_RX_INIT(own address); lcp_rx_feed() and
+ * lcp_rx_gap() in the UART RX path; when feed() returns ARACHNAE_OK, pass lcp_rx_frame()
+ * (or a copy of it) to lcp_dispatch() from the main loop.
  */
 #include "arachnae.h"
+
+/* The role's byte parser: arachnae_parser's states and verdicts (arachnae.h), with the role's largest
+ * frame (15 bytes), own address and lcp_payload_check built in (issue 15: no
+ * pointers or 16-bit counts to carry where the role does not need them). */
+typedef struct {
+    uint8_t state;
+    uint8_t count;
+    uint8_t own;     /* the node's address, one of the role's */
+    uint8_t buf[ARACHNAE_RX_MAX_LCP];
+} lcp_rx;
+#define LCP_RX_INIT(own) { ARACHNAE_PS_RECEIVING, 0u, (own), { 0u } }
+arachnae_status lcp_rx_feed(lcp_rx *p, uint8_t byte);
+arachnae_status lcp_rx_gap(lcp_rx *p);
+/* The last complete and valid frame (NULL if none since the last gap), as arachnae_parser_frame(). */
+static inline const uint8_t *lcp_rx_frame(const lcp_rx *p, uint16_t *len)
+{
+    if (p->state < ARACHNAE_PS_READY)
+        return 0;
+    *len = p->count;
+    return p->buf;
+}
 
 typedef struct lcp_node {
     uint8_t address; /* own address */

@@ -8,11 +8,32 @@
  * common handling of .
  * The behaviour is hand-written (firmware/nodes/mcp.c) and defines the
  * functions under "defined by the behaviour"; regeneration never touches it.
- * Use: arachnae_parser_init(&parser, buf, ARACHNAE_RX_MAX_MCP, node.address,
- * mcp_payload_check) in the UART RX path; when feed() returns ARACHNAE_OK,
- * pass arachnae_parser_frame() (or a copy of it) to mcp_dispatch() from the main loop.
+ * Use: static mcp_rx rx = MCP_RX_INIT(own address); mcp_rx_feed() and
+ * mcp_rx_gap() in the UART RX path; when feed() returns ARACHNAE_OK, pass mcp_rx_frame()
+ * (or a copy of it) to mcp_dispatch() from the main loop.
  */
 #include "arachnae.h"
+
+/* The role's byte parser: arachnae_parser's states and verdicts (arachnae.h), with the role's largest
+ * frame (31 bytes), only address 0x01 and mcp_payload_check built in (issue 15: no
+ * pointers or 16-bit counts to carry where the role does not need them). */
+typedef struct {
+    uint8_t state;
+    uint8_t count;
+    uint8_t buf[ARACHNAE_RX_MAX_MCP];
+} mcp_rx;
+/* `own` is the role's only address, 0x01 (as mcp_node_init takes): built in */
+#define MCP_RX_INIT(own) { ARACHNAE_PS_RECEIVING, 0u, { 0u } }
+arachnae_status mcp_rx_feed(mcp_rx *p, uint8_t byte);
+arachnae_status mcp_rx_gap(mcp_rx *p);
+/* The last complete and valid frame (NULL if none since the last gap), as arachnae_parser_frame(). */
+static inline const uint8_t *mcp_rx_frame(const mcp_rx *p, uint16_t *len)
+{
+    if (p->state < ARACHNAE_PS_READY)
+        return 0;
+    *len = p->count;
+    return p->buf;
+}
 
 typedef struct mcp_node {
     uint8_t address; /* own address */

@@ -8,11 +8,32 @@
  * common handling of INIT, ID_REQ, STATUS_REQ.
  * The behaviour is hand-written (firmware/nodes/np3.c) and defines the
  * functions under "defined by the behaviour"; regeneration never touches it.
- * Use: arachnae_parser_init(&parser, buf, ARACHNAE_RX_MAX_NP3, node.address,
- * np3_payload_check) in the UART RX path; when feed() returns ARACHNAE_OK,
- * pass arachnae_parser_frame() (or a copy of it) to np3_dispatch() from the main loop.
+ * Use: static np3_rx rx = NP3_RX_INIT(own address); np3_rx_feed() and
+ * np3_rx_gap() in the UART RX path; when feed() returns ARACHNAE_OK, pass np3_rx_frame()
+ * (or a copy of it) to np3_dispatch() from the main loop.
  */
 #include "arachnae.h"
+
+/* The role's byte parser: arachnae_parser's states and verdicts (arachnae.h), with the role's largest
+ * frame (11 bytes), only address 0x02 and np3_payload_check built in (issue 15: no
+ * pointers or 16-bit counts to carry where the role does not need them). */
+typedef struct {
+    uint8_t state;
+    uint8_t count;
+    uint8_t buf[ARACHNAE_RX_MAX_NP3];
+} np3_rx;
+/* `own` is the role's only address, 0x02 (as np3_node_init takes): built in */
+#define NP3_RX_INIT(own) { ARACHNAE_PS_RECEIVING, 0u, { 0u } }
+arachnae_status np3_rx_feed(np3_rx *p, uint8_t byte);
+arachnae_status np3_rx_gap(np3_rx *p);
+/* The last complete and valid frame (NULL if none since the last gap), as arachnae_parser_frame(). */
+static inline const uint8_t *np3_rx_frame(const np3_rx *p, uint16_t *len)
+{
+    if (p->state < ARACHNAE_PS_READY)
+        return 0;
+    *len = p->count;
+    return p->buf;
+}
 
 typedef struct np3_node {
     uint8_t address; /* own address */

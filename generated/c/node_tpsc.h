@@ -8,11 +8,32 @@
  * common handling of INIT, ID_REQ, STATUS_REQ.
  * The behaviour is hand-written (firmware/nodes/tpsc.c) and defines the
  * functions under "defined by the behaviour"; regeneration never touches it.
- * Use: arachnae_parser_init(&parser, buf, ARACHNAE_RX_MAX_TPSC, node.address,
- * tpsc_payload_check) in the UART RX path; when feed() returns ARACHNAE_OK,
- * pass arachnae_parser_frame() (or a copy of it) to tpsc_dispatch() from the main loop.
+ * Use: static tpsc_rx rx = TPSC_RX_INIT(own address); tpsc_rx_feed() and
+ * tpsc_rx_gap() in the UART RX path; when feed() returns ARACHNAE_OK, pass tpsc_rx_frame()
+ * (or a copy of it) to tpsc_dispatch() from the main loop.
  */
 #include "arachnae.h"
+
+/* The role's byte parser: arachnae_parser's states and verdicts (arachnae.h), with the role's largest
+ * frame (6 bytes), only address 0x28 and tpsc_payload_check built in (issue 15: no
+ * pointers or 16-bit counts to carry where the role does not need them). */
+typedef struct {
+    uint8_t state;
+    uint8_t count;
+    uint8_t buf[ARACHNAE_RX_MAX_TPSC];
+} tpsc_rx;
+/* `own` is the role's only address, 0x28 (as tpsc_node_init takes): built in */
+#define TPSC_RX_INIT(own) { ARACHNAE_PS_RECEIVING, 0u, { 0u } }
+arachnae_status tpsc_rx_feed(tpsc_rx *p, uint8_t byte);
+arachnae_status tpsc_rx_gap(tpsc_rx *p);
+/* The last complete and valid frame (NULL if none since the last gap), as arachnae_parser_frame(). */
+static inline const uint8_t *tpsc_rx_frame(const tpsc_rx *p, uint16_t *len)
+{
+    if (p->state < ARACHNAE_PS_READY)
+        return 0;
+    *len = p->count;
+    return p->buf;
+}
 
 typedef struct tpsc_node {
     uint8_t address; /* own address */

@@ -8,11 +8,32 @@
  * common handling of INIT, ID_REQ, STATUS_REQ.
  * The behaviour is hand-written (firmware/nodes/tsc.c) and defines the
  * functions under "defined by the behaviour"; regeneration never touches it.
- * Use: arachnae_parser_init(&parser, buf, ARACHNAE_RX_MAX_TSC, node.address,
- * tsc_payload_check) in the UART RX path; when feed() returns ARACHNAE_OK,
- * pass arachnae_parser_frame() (or a copy of it) to tsc_dispatch() from the main loop.
+ * Use: static tsc_rx rx = TSC_RX_INIT(own address); tsc_rx_feed() and
+ * tsc_rx_gap() in the UART RX path; when feed() returns ARACHNAE_OK, pass tsc_rx_frame()
+ * (or a copy of it) to tsc_dispatch() from the main loop.
  */
 #include "arachnae.h"
+
+/* The role's byte parser: arachnae_parser's states and verdicts (arachnae.h), with the role's largest
+ * frame (8 bytes), only address 0x2B and tsc_payload_check built in (issue 15: no
+ * pointers or 16-bit counts to carry where the role does not need them). */
+typedef struct {
+    uint8_t state;
+    uint8_t count;
+    uint8_t buf[ARACHNAE_RX_MAX_TSC];
+} tsc_rx;
+/* `own` is the role's only address, 0x2B (as tsc_node_init takes): built in */
+#define TSC_RX_INIT(own) { ARACHNAE_PS_RECEIVING, 0u, { 0u } }
+arachnae_status tsc_rx_feed(tsc_rx *p, uint8_t byte);
+arachnae_status tsc_rx_gap(tsc_rx *p);
+/* The last complete and valid frame (NULL if none since the last gap), as arachnae_parser_frame(). */
+static inline const uint8_t *tsc_rx_frame(const tsc_rx *p, uint16_t *len)
+{
+    if (p->state < ARACHNAE_PS_READY)
+        return 0;
+    *len = p->count;
+    return p->buf;
+}
 
 typedef struct tsc_node {
     uint8_t address; /* own address */

@@ -8,11 +8,32 @@
  * common handling of INIT, ID_REQ, STATUS_REQ.
  * The behaviour is hand-written (firmware/nodes/uic_rcp.c) and defines the
  * functions under "defined by the behaviour"; regeneration never touches it.
- * Use: arachnae_parser_init(&parser, buf, ARACHNAE_RX_MAX_UIC_RCP, node.address,
- * uic_rcp_payload_check) in the UART RX path; when feed() returns ARACHNAE_OK,
- * pass arachnae_parser_frame() (or a copy of it) to uic_rcp_dispatch() from the main loop.
+ * Use: static uic_rcp_rx rx = UIC_RCP_RX_INIT(own address); uic_rcp_rx_feed() and
+ * uic_rcp_rx_gap() in the UART RX path; when feed() returns ARACHNAE_OK, pass uic_rcp_rx_frame()
+ * (or a copy of it) to uic_rcp_dispatch() from the main loop.
  */
 #include "arachnae.h"
+
+/* The role's byte parser: arachnae_parser's states and verdicts (arachnae.h), with the role's largest
+ * frame (24 bytes), only address 0x07 and uic_rcp_payload_check built in (issue 15: no
+ * pointers or 16-bit counts to carry where the role does not need them). */
+typedef struct {
+    uint8_t state;
+    uint8_t count;
+    uint8_t buf[ARACHNAE_RX_MAX_UIC_RCP];
+} uic_rcp_rx;
+/* `own` is the role's only address, 0x07 (as uic_rcp_node_init takes): built in */
+#define UIC_RCP_RX_INIT(own) { ARACHNAE_PS_RECEIVING, 0u, { 0u } }
+arachnae_status uic_rcp_rx_feed(uic_rcp_rx *p, uint8_t byte);
+arachnae_status uic_rcp_rx_gap(uic_rcp_rx *p);
+/* The last complete and valid frame (NULL if none since the last gap), as arachnae_parser_frame(). */
+static inline const uint8_t *uic_rcp_rx_frame(const uic_rcp_rx *p, uint16_t *len)
+{
+    if (p->state < ARACHNAE_PS_READY)
+        return 0;
+    *len = p->count;
+    return p->buf;
+}
 
 typedef struct uic_rcp_node {
     uint8_t address; /* own address */

@@ -363,9 +363,10 @@ def test_linker_drops_what_a_role_does_not_use(spec, tmp_path):
         if m.name.lower() not in used:
             assert not present, f"{m.name} code linked into the TPSC image"
     # the skeleton writes ID_ACK's one byte itself: no ID_ACK function, nor the whole-frame check (the parser
-    # inlines its envelope check), is linked (issue 15)
+    # inlines its envelope check), nor the generic parser (the role has its own), is linked (issue 15)
     assert not any(n.startswith("arachnae_id_ack_") for n in names) and "tpsc_dispatch" in names
-    assert "arachnae_frame_check" not in names and "arachnae_parser_feed" in names
+    assert "arachnae_frame_check" not in names and "tpsc_rx_feed" in names
+    assert not any(n.startswith("arachnae_parser_") for n in names)
     assert not any(n.startswith("arachnae_log10_") for n in names)
     assert "arachnae_messages" not in names  # the reflection layer stays out
     # and it works: ID_REQ in, ID_ACK out

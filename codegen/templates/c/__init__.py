@@ -326,6 +326,20 @@ class RoleView:
         return f"ARACHNAE_NODE_{self.role.upper()}_H"
 
     @property
+    def multi_address(self) -> bool:
+        """More than one node has this role: its parser keeps the own address (node_<role>.h)."""
+        return len(self.nodes) > 1
+
+    @property
+    def rx_count_t(self) -> str:
+        """Type of the role parser's byte count: 8 bits where the role's largest frame allows (AVR flash)."""
+        return "uint8_t" if self.rx_max <= 0xFF else "uint16_t"
+
+    @property
+    def rx_init(self) -> str:
+        return f"{self.role.upper()}_RX_INIT"
+
+    @property
     def empty_receives(self) -> list[MessageView]:
         """Received messages without fields: one shared `len != 0` check in the payload check."""
         return [m for m in self.receives if not m.has_fields]
