@@ -111,7 +111,6 @@ arachnae_status apu_sdf_rx_gap(apu_sdf_rx *p)
 arachnae_status apu_sdf_dispatch(apu_sdf_node *node, const uint8_t *frame)
 {
     arachnae_header *h = &node->rx;
-    arachnae_status st;
     uint8_t op, n;
     arachnae_frame_header(frame, h);
     switch (h->opcode) {
@@ -129,11 +128,15 @@ arachnae_status apu_sdf_dispatch(apu_sdf_node *node, const uint8_t *frame)
         /* seed 3.2.3: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_BUSY) */
         node->msg.reply_status.status = 0;
         apu_sdf_on_status_req(node, h, &node->msg.reply_status);
-        st = arachnae_status_ack_busy_check(&node->msg.reply_status);
-        if (st != ARACHNAE_OK)
-            return st;
+        {
+            /* arachnae_status_ack_busy_check and _pack, inlined: no call, no function linked (issue 15) */
+            const arachnae_status_ack_busy_t *m = &node->msg.reply_status;
+            if (!(m->status <= 1u))
+                return ARACHNAE_RANGE;
+            (node->out + ARACHNAE_FRAME_PAYLOAD)[0] = (uint8_t)(((unsigned)(uint16_t)m->status & 0xFFu));
+        }
+        n = 1u;
         op = ARACHNAE_OP_STATUS_ACK_BUSY;
-        n = arachnae_status_ack_busy_pack(&node->msg.reply_status, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
     case ARACHNAE_OP_XMIT_GRANT:
         apu_sdf_on_xmit_grant(node, h);

@@ -113,7 +113,6 @@ arachnae_status isc_dispatch(isc_node *node, const uint8_t *frame)
 {
     arachnae_header *h = &node->rx;
     const uint8_t *payload = frame + ARACHNAE_FRAME_PAYLOAD;
-    arachnae_status st;
     uint8_t op, n;
     arachnae_frame_header(frame, h);
     switch (h->opcode) {
@@ -131,11 +130,15 @@ arachnae_status isc_dispatch(isc_node *node, const uint8_t *frame)
         /* seed 3.2.10: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_ORDER) */
         node->msg.reply_status.status = 0;
         isc_on_status_req(node, h, &node->msg.reply_status);
-        st = arachnae_status_ack_order_check(&node->msg.reply_status);
-        if (st != ARACHNAE_OK)
-            return st;
+        {
+            /* arachnae_status_ack_order_check and _pack, inlined: no call, no function linked (issue 15) */
+            const arachnae_status_ack_order_t *m = &node->msg.reply_status;
+            if (!(m->status <= 1u))
+                return ARACHNAE_RANGE;
+            (node->out + ARACHNAE_FRAME_PAYLOAD)[0] = (uint8_t)(((unsigned)(uint16_t)m->status & 0xFFu));
+        }
+        n = 1u;
         op = ARACHNAE_OP_STATUS_ACK_ORDER;
-        n = arachnae_status_ack_order_pack(&node->msg.reply_status, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
     case ARACHNAE_OP_XMIT_DATA:
         isc_on_xmit_data(node, h);

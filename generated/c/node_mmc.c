@@ -121,7 +121,6 @@ arachnae_status mmc_dispatch(mmc_node *node, const uint8_t *frame)
 {
     arachnae_header *h = &node->rx;
     const uint8_t *payload = frame + ARACHNAE_FRAME_PAYLOAD;
-    arachnae_status st;
     uint8_t op, n;
     arachnae_frame_header(frame, h);
     switch (h->opcode) {
@@ -142,11 +141,22 @@ arachnae_status mmc_dispatch(mmc_node *node, const uint8_t *frame)
         node->msg.reply_status.leg = 0;
         node->msg.reply_status.error = 0;
         mmc_on_status_req(node, h, &node->msg.reply_status);
-        st = arachnae_status_ack_mmc_check(&node->msg.reply_status);
-        if (st != ARACHNAE_OK)
-            return st;
+        {
+            /* arachnae_status_ack_mmc_check and _pack, inlined: no call, no function linked (issue 15) */
+            const arachnae_status_ack_mmc_t *m = &node->msg.reply_status;
+            if (!(m->gait >= 7u && m->gait <= 9u))
+                return ARACHNAE_RANGE;
+            if (!(m->direction <= 6u))
+                return ARACHNAE_RANGE;
+            if (!(m->leg <= 6u))
+                return ARACHNAE_RANGE;
+            if (!(m->error <= 5u))
+                return ARACHNAE_RANGE;
+            (node->out + ARACHNAE_FRAME_PAYLOAD)[0] = (uint8_t)((((unsigned)(uint16_t)m->gait & 0x0Fu) << 4) | ((unsigned)(uint16_t)m->direction & 0x0Fu));
+            (node->out + ARACHNAE_FRAME_PAYLOAD)[1] = (uint8_t)((((unsigned)(uint16_t)m->leg & 0x0Fu) << 4) | ((unsigned)(uint16_t)m->error & 0x0Fu));
+        }
+        n = 2u;
         op = ARACHNAE_OP_STATUS_ACK_MMC;
-        n = arachnae_status_ack_mmc_pack(&node->msg.reply_status, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
     case ARACHNAE_OP_ID_ACK: {
         /* arachnae_id_ack_unpack, inlined: one call less per message (issue 15) */

@@ -118,7 +118,6 @@ arachnae_status usrc_dispatch(usrc_node *node, const uint8_t *frame)
 {
     arachnae_header *h = &node->rx;
     const uint8_t *payload = frame + ARACHNAE_FRAME_PAYLOAD;
-    arachnae_status st;
     uint8_t op, n;
     arachnae_frame_header(frame, h);
     switch (h->opcode) {
@@ -136,11 +135,15 @@ arachnae_status usrc_dispatch(usrc_node *node, const uint8_t *frame)
         /* seed 3.2.11: STATUS_REQ is answered with this role's STATUS_ACK (STATUS_ACK_RANGE) */
         node->msg.reply_status.status = 0;
         usrc_on_status_req(node, h, &node->msg.reply_status);
-        st = arachnae_status_ack_range_check(&node->msg.reply_status);
-        if (st != ARACHNAE_OK)
-            return st;
+        {
+            /* arachnae_status_ack_range_check and _pack, inlined: no call, no function linked (issue 15) */
+            const arachnae_status_ack_range_t *m = &node->msg.reply_status;
+            if (!(m->status <= 2u))
+                return ARACHNAE_RANGE;
+            (node->out + ARACHNAE_FRAME_PAYLOAD)[0] = (uint8_t)(((unsigned)(uint16_t)m->status & 0xFFu));
+        }
+        n = 1u;
         op = ARACHNAE_OP_STATUS_ACK_RANGE;
-        n = arachnae_status_ack_range_pack(&node->msg.reply_status, node->out + ARACHNAE_FRAME_PAYLOAD);
         break;
     case ARACHNAE_OP_HEAD_SET_ABS: {
         /* arachnae_head_set_abs_unpack, inlined: one call less per message (issue 15) */
