@@ -180,7 +180,7 @@ def tuning(role: str) -> list[str]:
     return out
 
 
-_PROTO = re.compile(r"^(void|arachnae_status)\s+(\w+)\((.*)\);$")
+_PROTO = re.compile(r"^(void|arachnae_status|uint8_t)\s+(\w+)\((.*)\);$")
 
 
 def stub_source(role: str) -> str:
@@ -197,8 +197,10 @@ def stub_source(role: str) -> str:
         ret, name, args = m.groups()
         params = [a.strip().split()[-1].lstrip("*") for a in args.split(",") if a.strip() and a.strip() != "void"]
         body = "".join(f" (void){p};" for p in params)
-        if ret != "void":
+        if ret == "arachnae_status":
             body += " return ARACHNAE_OK;"
+        elif ret == "uint8_t":
+            body += " return 0;"   # a request's callback: no reply now
         out.append(f"{ret} {name}({args}) {{{body} }}")
     return "\n".join(out) + "\n"
 

@@ -20,7 +20,13 @@ void tpsc_on_status_req(tpsc_node *node, const arachnae_header *h, arachnae_stat
     (void)h;
     reply->status = ARACHNAE_ORDER_STATUS_IN_ORDER;
 }
-void tpsc_on_xmit_data(tpsc_node *node, const arachnae_header *h) { (void)node; (void)h; }
+uint8_t tpsc_on_xmit_data(tpsc_node *node, const arachnae_header *h, arachnae_xmit_data_tpsc_t *reply)
+{
+    (void)node;
+    (void)h;
+    reply->contact = ARACHNAE_TPSC_CONTACT_OBJ_BOTH;
+    return 1;
+}
 
 int main(void)
 {
