@@ -115,3 +115,16 @@ def test_stack_figures_cover_the_decode_paths(firmware_built):
         if row["target"] == "avr":
             static = sum(row[p][k] for p in ("codec", "skeleton", "firmware", "runtime") for k in ("data", "bss"))
             assert 0 < static + row["stack"]["node"] < 2048, row
+
+
+def test_make_size_shows_the_simavr_ram_high_water_mark_within_the_static_worst_case(firmware_built):
+    """Issue 15 item 4: a sensor role's simavr high-water mark (one short run, TPSC here) beside the static figure;
+    the run cannot go deeper than the call graph's worst case, and it does use stack beyond the static RAM."""
+    r, rows = report(firmware_built, "--sil-ram", "tpsc")
+    assert r.returncode == 0, r.stderr
+    assert "simavr RAM" in r.stdout
+    avr = {row["role"]: row for row in rows if row["target"] == "avr"}
+    tpsc = avr["tpsc"]
+    static = sum(tpsc[p][k] for p in ("codec", "skeleton", "firmware", "runtime") for k in ("data", "bss"))
+    assert static < tpsc["sim_ram"] <= static + tpsc["stack"]["node"], tpsc
+    assert all(row["sim_ram"] is None for role, row in avr.items() if role != "tpsc")
