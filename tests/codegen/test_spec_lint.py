@@ -99,6 +99,26 @@ CASES = [
     ("carried_in_without_its_code", M, "bits: {OBJ_LEFT: 0x10, OBJ_RIGHT: 0x20, OBJ_BOTH: 0x40}",
      "bits: {OBJ_LEFT: 0x10, OBJ_RIGHT: 0x20, BOTH: 0x40}", "carried_in: XMIT_DATA_TPSC, from: [TPSC], to: [SPU], doc: \"Both",
      "OBJ_BOTH: XMIT_DATA_TPSC has no flags bit or enum value named OBJ_BOTH to carry it"),
+    # seed 3.2.2, 6.2: which fields a sensor's records carry, and what its SET_ALARM threshold is compared with
+    ("record_values_unknown_field", M, "record_values: [left, center, right]", "record_values: [left, centre, right]",
+     None, "XMIT_DATA_IRRC: record_values names 'centre', which is no field of it"),
+    ("record_value_wider_than_a_byte", M, "record_values: [distance]\n    record_channel: angle",
+     "record_values: [distance, angle]", None, "XMIT_DATA_USRC.angle: a record carries one value byte, not a 16-bit uint"),
+    ("record_values_of_two_encodings", M, "record_values: [temperature]\n    record_channel: channel\n",
+     "record_values: [temperature, channel]\n", None,
+     "XMIT_DATA_TSC.channel: encoded unlike temperature; a record's values share one encoding"),
+    ("record_channel_unknown", M, "record_channel: angle", "record_channel: heading", None,
+     "XMIT_DATA_USRC: record_channel 'heading' is no unsigned integer field of it"),
+    ("compared_with_unknown", M, "compared_with: XMIT_DATA_IRRC", "compared_with: XMIT_DATA_IRRX", None,
+     "SET_ALARM_IRRC.limit: compared_with 'XMIT_DATA_IRRX', which is no message with record_values"),
+    ("compared_with_another_role", M, "[4.2, 5.0], compared_with: XMIT_DATA_PSC", "[4.2, 5.0], compared_with: XMIT_DATA_LSC", None,
+     "SET_ALARM_PSC.limit: goes to PSC, but XMIT_DATA_LSC comes from LSC"),
+    ("compared_with_another_unit", M, "[4.2, 5.0], compared_with: XMIT_DATA_PSC", "[4.2, 5.0], compared_with: XMIT_DATA_LSC", None,
+     "SET_ALARM_PSC.limit: unit 'V', but XMIT_DATA_LSC.brightness is in 'lx'"),
+    ("two_thresholds_for_one_data", M, "[4.2, 5.0], compared_with: XMIT_DATA_PSC", "[4.2, 5.0], compared_with: XMIT_DATA_LSC", None,
+     "SET_ALARM_PSC.limit: SET_ALARM_LSC already sets the threshold for XMIT_DATA_LSC"),
+    ("threshold_beyond_the_data", M, "unit: degC, range: [0, 63], compared_with", "unit: degC, range: [0, 120], compared_with",
+     None, "SET_ALARM_TSC.limit: range [0, 120] reaches beyond XMIT_DATA_TSC.temperature's [-20, 100]"),
 ]
 
 
