@@ -13,10 +13,8 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
-import jsonschema
-
 from arachnae.errors import UserError, located
-from arachnae.validation import Validator
+from arachnae.validation import field_name, schema_errors
 from codegen.encoding import Linear, Log10, to_fraction
 from codegen.generate import LANGUAGES
 from codegen.model import Checksum, Spec, enum_values_of
@@ -50,38 +48,13 @@ def _lint_text(path: Path, doc: Any, node: Any, where: list[Any], report: Report
     for key, value in items:
         for text in (key, value):
             if isinstance(text, str) and any(0xD800 <= ord(ch) <= 0xDFFF for ch in text):
-                report.add(path, doc, where + [key], f"{'.'.join(map(str, where + [key]))}: {text!r} contains a lone surrogate, not text")
+                report.add(path, doc, where + [key], f"{field_name(where + [key])}: {text!r} contains a lone surrogate, not text")
         _lint_text(path, doc, value, where + [key], report)
 
 
 def _schema_check(path: Path, doc: Any, schema_name: str, report: Report) -> None:
-    validator = Validator(load_yaml(SCHEMA_DIR / schema_name))
-    by_field: dict[tuple[str, ...], list[jsonschema.ValidationError]] = {}
-    for err in sorted(validator.iter_errors(doc), key=lambda e: list(map(str, e.absolute_path))):
-        by_field.setdefault(tuple(map(str, err.absolute_path)), []).append(err)
-    for errs in by_field.values():            # one line per field: its first problem, or all its missing keys
-        where = list(errs[0].absolute_path)
-        field = ".".join(str(p) for p in where) or "(top level)"
-        missing = [e.message.split(" is a required")[0] for e in errs if e.validator == "required"]
-        text = f"{', '.join(missing)} {'are' if len(missing) > 1 else 'is'} missing" if missing else _schema_message(errs[0])
-        report.add(path, doc, where, f"{field}: {text}")
-
-
-def _schema_message(err: jsonschema.ValidationError) -> str:
-    if err.validator == "additionalProperties":
-        return err.message.replace("Additional properties are not allowed", "unknown key(s)")
-    if err.validator == "required":
-        return err.message.replace("is a required property", "is missing")
-    if err.validator == "type":
-        return f"{err.instance!r} is not {_TYPE_WORDS.get(str(err.validator_value), err.validator_value)}"
-    if err.validator == "pattern" and "description" in err.schema:
-        return f"{err.instance!r} is not {err.schema['description']}"
-    return err.message
-
-
-_TYPE_WORDS = {"integer": "an integer", "number": "a finite number", "string": "a string", "boolean": "true or false",
-               "object": "a mapping", "array": "a list", "['number', 'string']": "a finite number or a fraction 'a/b'",
-               "['string', 'null']": "a string or null"}
+    """Structure, worded as every other schema check of the toolkit (arachnae.validation: `file:line: field: problem`)."""
+    report.problems += [one_line(str(e)) for e in schema_errors(doc, load_yaml(SCHEMA_DIR / schema_name))]
 
 
 def check_documents(nodes_path: Path, messages_path: Path) -> tuple[dict, dict]:
