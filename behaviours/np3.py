@@ -33,7 +33,7 @@ from behaviours.np3_layers import (AVOIDANCE, REFLEXES, Tuning, body_frame, clos
                                    steepness_deg, uphill)
 from behaviours.runtime import Runtime
 from behaviours.topomap import OCCUPIED, OccupancyGrid, Reading, TopoMap, ray_cells
-from behaviours.units import XMIT_DATA_OF, Quantizer, from_record_byte, quantizer
+from behaviours.units import RECORD_QUANTIZER, Quantizer, from_record_byte
 
 _VALUE, _ALARM, _STATUS = int(RecordKind.VALUE), int(RecordKind.ALARM), int(RecordKind.STATUS)
 _IR_BAD = {int(RangeStatus.UNRELIABLE), int(RangeStatus.OUT_OF_ORDER)}
@@ -41,9 +41,8 @@ _NO_GROUND, _BLOCKED = int(MmcError.NO_GROUND), int(MmcError.LEG_DRIVE_BLOCKED)
 _STOP, _FORWARD, _BACKWARD = int(MovCmd.STOP), int(MovCmd.FORWARD), int(MovCmd.BACKWARD)
 _LEFT, _RIGHT = int(MovCmd.TURN_LEFT), int(MovCmd.TURN_RIGHT)
 _SIDE_L, _SIDE_R = int(MovCmd.SIDESTEP_LEFT), int(MovCmd.SIDESTEP_RIGHT)
-# the field of each source role's XMIT_DATA layout whose encoding its records carry (spec messages)
-_FIELD = {"IRRC": "center", "ISC": "longitudinal", "LSC": "brightness", "PSC": "voltage", "USRC": "distance"}
-_Q: dict[str, Quantizer] = {role: quantizer(XMIT_DATA_OF[role], f) for role, f in _FIELD.items()}
+# the encoding each source role's records carry (spec messages.<m>.record_values)
+_Q: dict[str, Quantizer] = RECORD_QUANTIZER
 
 
 def decode(role: str, value: int) -> float:

@@ -26,7 +26,7 @@ from behaviours import tuning as T
 from behaviours.post import PostMaster
 from behaviours.runtime import PRIORITY_REFLEX, Runtime, slaves_of
 from behaviours.sensors import ABOVE, BELOW, BEYOND, AlarmLimit, limit_in
-from behaviours.units import XMIT_DATA_OF, quantizer, record_byte
+from behaviours.units import XMIT_DATA_OF, record_byte, values_quantizer
 
 # each sensor role's STATUS_ACK layout; the range sensors are the ones with UNRELIABLE (3.2.11, 3.2.13)
 STATUS_OF = {role: cls for cls in (M.StatusAckRange, M.StatusAckOrder) for role in cls.SENDERS}
@@ -37,28 +37,24 @@ _KIND_NAME = {int(k): k.name.lower() for k in RecordKind}
 
 
 def channels(role: str, msg: Any) -> dict[int, int]:
-    """A sensor's reply as {record channel: raw value} (the record contract: IRRC beam, ISC axis,
-    TSC probe, USRC head angle; 0 otherwise)."""
-    if role == "USRC":
-        return {msg.angle: msg.distance}
-    if role == "IRRC":
-        return {0: msg.left, 1: msg.center, 2: msg.right}
-    if role == "ISC":
-        return {int(IscAxis.LONGITUDINAL): msg.longitudinal, int(IscAxis.TRANSVERSE): msg.transverse}
-    if role == "TSC":
-        return {msg.channel: msg.temperature}
-    (only,) = XMIT_DATA_OF[role].FIELDS           # TPSC, LSC, PSC: a record of one field
-    return {0: getattr(msg, only.name)}
+    """A sensor's reply as {record channel: raw value} (spec record_values: the channel is a field's position,
+    IRRC beam, ISC axis, or the value of the record_channel field, USRC head angle, TSC probe)."""
+    r = M.RECORD_VALUES[role]
+    if r.channel is not None:
+        (only,) = r.fields
+        return {getattr(msg, r.channel): getattr(msg, only)}
+    return {ch: getattr(msg, f) for ch, f in enumerate(r.fields)}
 
 
 def alarm_setup() -> list[tuple[str, M.Message, list[tuple[int, AlarmLimit]]]]:
     """The SET_ALARM frames for each sensor role with the limits (in the data's raw steps) they set, per channel."""
-    ir, isc = quantizer(M.XmitDataIrrc, "center"), quantizer(M.XmitDataIsc, "longitudinal")
-    tsc, lsc, psc = (quantizer(M.XmitDataTsc, "temperature"), quantizer(M.XmitDataLsc, "brightness"),
-                     quantizer(M.XmitDataPsc, "voltage"))
+    # each limit in the raw steps of the record values it is compared with (spec compared_with)
+    q = {role: values_quantizer(a.data) for role, a in M.ALARM_THRESHOLDS.items()}
+    ir, isc, tsc, lsc, psc = (q[role] for role in ("IRRC", "ISC", "TSC", "LSC", "PSC"))
     out: list[tuple[str, M.Message, list[tuple[int, AlarmLimit]]]] = []
     m: M.Message = M.SetAlarmIrrc.from_phys(limit=T.SPU_ALARM_IRRC_CM)           # seed 3.2.13
-    out.append(("IRRC", m, [(b, AlarmLimit(limit_in(ir, M.SetAlarmIrrc, m.limit), BELOW, 0)) for b in range(3)]))
+    beams = range(len(M.ALARM_THRESHOLDS["IRRC"].data.fields))                   # one limit for every beam
+    out.append(("IRRC", m, [(b, AlarmLimit(limit_in(ir, M.SetAlarmIrrc, m.limit), BELOW, 0)) for b in beams]))
     for axis in IscAxis:                                                          # seed 3.2.14
         m = M.SetAlarmIsc.from_phys(channel=int(axis), limit=T.SPU_ALARM_ISC_DEG[int(axis)])
         out.append(("ISC", m, [(int(axis), AlarmLimit(limit_in(isc, M.SetAlarmIsc, m.limit), BEYOND, 0))]))

@@ -66,3 +66,15 @@ def quantizer(message: type[Message], field: str) -> Quantizer:
 
         return Quantizer(raw_log, conv.to_phys, lo, hi)
     raise ValueError(f"{message.NAME}.{field} has no physical conversion")
+
+
+def values_quantizer(values: _M.RecordValues) -> Quantizer:
+    """The conversion of a sensor's record values (spec record_values: one encoding for all its fields)."""
+    return quantizer(values.message, values.fields[0])
+
+
+# seed 3.2.2, 6.2: per sensor role whose records carry a number (the TPSC's carry contact flags), the conversion of
+# the value byte (a record's value is the raw value of one of its record_values, signed as two's complement)
+RECORD_QUANTIZER: dict[str, Quantizer] = {
+    role: values_quantizer(r) for role, r in _M.RECORD_VALUES.items()
+    if next(f for f in r.message.FIELDS if f.name == r.fields[0]).conv is not None}

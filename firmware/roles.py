@@ -137,27 +137,22 @@ def slave_timing(net, node, t, rank: int) -> list[str]:
     ]
 
 
-# a sensor's SET_ALARM limit and the data field it is compared with (behaviours/sensors.py)
-ALARM_FIELDS = {"IRRC": ("SetAlarmIrrc", "XmitDataIrrc", "center"), "ISC": ("SetAlarmIsc", "XmitDataIsc", "longitudinal"),
-                "TSC": ("SetAlarmTsc", "XmitDataTsc", "temperature"), "LSC": ("SetAlarmLsc", "XmitDataLsc", "brightness"),
-                "PSC": ("SetAlarmPsc", "XmitDataPsc", "voltage")}
-
-
 def alarm_limit(role: str) -> list[str]:
     """Whether the SET_ALARM limit's raw value IS the data field's raw value (behaviours.sensors.limit_in is the
     identity over the limit's whole raw range): then the firmware compares it as it comes, without linking the
     physical conversions (LSC: a log table); else it converts through the generated _to_milli/_from_milli."""
-    if role not in ALARM_FIELDS:
-        return []
     from arachnae_proto import messages as M
+    if role not in M.ALARM_THRESHOLDS:
+        return []
     from behaviours.sensors import limit_in
-    from behaviours.units import quantizer
-    alarm, data, field = ALARM_FIELDS[role]
-    info = next(f for f in getattr(M, alarm).FIELDS if f.name == "limit")
+    from behaviours.units import values_quantizer
+    a = M.ALARM_THRESHOLDS[role]           # the spec's threshold and the record values it is compared with
+    info = next(f for f in a.message.FIELDS if f.name == a.limit)
     lo, hi = info.conv.lo, info.conv.hi
-    same = all(limit_in(quantizer(getattr(M, data), field), getattr(M, alarm), r) == r for r in range(lo, hi + 1))
-    return [f"/* SET_ALARM limit raw {lo}..{hi} equals the {field} raw value for every value (checked by roles.py) */",
-            f"#define FW_ALARM_LIMIT_IS_DATA_RAW {1 if same else 0}"]
+    data = values_quantizer(a.data)
+    same = all(limit_in(data, a.message, r) == r for r in range(lo, hi + 1))
+    return [f"/* {a.message.NAME}.{a.limit} raw {lo}..{hi} equals the {'/'.join(a.data.fields)} raw value for every "
+            f"value (checked by roles.py) */", f"#define FW_ALARM_LIMIT_IS_DATA_RAW {1 if same else 0}"]
 
 
 def tuning(role: str) -> list[str]:

@@ -388,11 +388,8 @@ class SilNode:
 @lru_cache(maxsize=None)
 def _quantizers() -> dict[str, Any]:
     """The sensors' field conversions (behaviours.units), the front end's transfer functions."""
-    from arachnae_proto import messages as M
-    from behaviours.units import quantizer
-    return {"us": quantizer(M.XmitDataUsrc, "distance"), "ir": quantizer(M.XmitDataIrrc, "center"),
-            "isc": quantizer(M.XmitDataIsc, "longitudinal"), "tsc": quantizer(M.XmitDataTsc, "temperature"),
-            "lsc": quantizer(M.XmitDataLsc, "brightness"), "psc": quantizer(M.XmitDataPsc, "voltage")}
+    from behaviours.units import RECORD_QUANTIZER as Q          # the spec's record_values of each sensor
+    return {"us": Q["USRC"], "ir": Q["IRRC"], "isc": Q["ISC"], "tsc": Q["TSC"], "lsc": Q["LSC"], "psc": Q["PSC"]}
 
 
 def sil_factory(elf: Path | str | None = None, made: list[SilNode] | None = None) -> Callable[..., SilNode]:
