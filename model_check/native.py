@@ -264,7 +264,8 @@ typedef struct {
 typedef struct {
     uint8_t *keys; int32_t *parent, *table, *dst; RULE_T *rules; uint16_t *degree;
     int64_t width, tbits, tlimit, kcap, ecap, dcap, nk, ne, i, workers, edges_max, narrow, fan,
-            seen_states, seen_edges, rounds, status, cap, bcount, bsense, nrounds, nsplit, ndropped;
+            seen_states, seen_edges, rounds, status, cap, bcount, bsense, nrounds, nsplit, ndropped,
+            nslices, cexp, cmark, cins;
     Res hit;
 } Ctx;
 enum { P_RUN, P_DONE, P_PAUSE, P_GROW, P_HIT };
@@ -351,6 +352,27 @@ static int64_t pmark(const Ctx *c, Slice *sl, int64_t t) {
     }
     return fresh;
 }
+/* the first free slot from `slot` on (probe step `step`) takes id, with a compare-and-swap:
+   other threads claim slots at the same time */
+static inline void pclaim(int32_t *table, U slot, U step, U tmask, int32_t id) {
+    for (;; step++) {
+        int32_t empty = -1;
+        if (__atomic_load_n(&table[slot], __ATOMIC_RELAXED) < 0 &&
+            __atomic_compare_exchange_n(&table[slot], &empty, id, 0, __ATOMIC_RELAXED, __ATOMIC_RELAXED))
+            return;
+        slot = (slot + step) & tmask;
+    }
+}
+/* rehash's part lo .. hi-1 on one of several threads at once (the slot order may differ) */
+void prehash(const uint8_t *keys, int64_t lo, int64_t hi, int32_t *table, int64_t tbits) {
+    U tmask = ((U)1 << tbits) - 1, t[W];
+    for (int64_t i = lo; i < hi; i++) {
+        memset(t, 0, sizeof t);
+        memcpy(t, keys + (size_t)i * KW, KW);
+        HASH_SLOT();
+        pclaim(table, slot, 1, tmask, (int32_t)i);
+    }
+}
 static void pinsert(const Ctx *c, Slice *sl, int64_t t) {
     Slice *q = &sl[t];
     U tmask = ((U)1 << c->tbits) - 1;
@@ -359,14 +381,7 @@ static void pinsert(const Ctx *c, Slice *sl, int64_t t) {
         int32_t id = (int32_t)(q->base + q->cidx[d]);
         memcpy(c->keys + (size_t)id * KW, q->crow + (size_t)d * KW, KW);
         c->parent[id] = q->cpar[d];
-        U slot = (U)q->cslot[d];
-        for (U step = (U)q->cstep[d];; step++) {
-            int32_t empty = -1;
-            if (__atomic_load_n(&c->table[slot], __ATOMIC_RELAXED) < 0 &&
-                __atomic_compare_exchange_n(&c->table[slot], &empty, id, 0, __ATOMIC_RELAXED, __ATOMIC_RELAXED))
-                break;
-            slot = (slot + step) & tmask;
-        }
+        pclaim(c->table, (U)q->cslot[d], (U)q->cstep[d], tmask, id);
     }
     int32_t *dst = c->dst + q->edge0;
     RULE_T *rules = c->rules + q->edge0;
@@ -382,7 +397,8 @@ static void pinsert(const Ctx *c, Slice *sl, int64_t t) {
 }
 /* thread 0, before a round: the slices, or why not (the search is over, arrays to grow, a pause) */
 static void pplan(Ctx *c, Slice *sl) {
-    int64_t n = c->workers;
+    int64_t n = c->nslices;
+    c->cmark = 0;
     if (c->status != P_RUN) return;
     if (c->i == c->nk) { c->status = P_DONE; return; }
     if (c->rounds-- <= 0) { c->status = P_PAUSE; return; }
@@ -404,12 +420,13 @@ static void pplan(Ctx *c, Slice *sl) {
 /* thread 0, after the marks: bases and edge places of the kept slices, the counts, a hit */
 static void psettle(Ctx *c, Slice *sl) {
     int64_t nk = c->nk, ne = c->ne, last = 0, busy = 0;
-    for (int64_t u = 0; u < c->workers && sl[u].kept; u++) {
+    c->cexp = c->cins = 0;
+    for (int64_t u = 0; u < c->nslices && sl[u].kept; u++) {
         sl[u].base = nk; nk += sl[u].fresh;
         sl[u].edge0 = ne; ne += sl[u].r.edges;
         last = u;
     }
-    for (int64_t u = 0; u < c->workers; u++) busy += sl[u].a < sl[u].b;
+    for (int64_t u = 0; u < c->nslices; u++) busy += sl[u].a < sl[u].b;
     c->nrounds++;
     c->nsplit += busy > 1;
     c->ndropped += busy > last + 1;
@@ -428,25 +445,36 @@ static void psettle(Ctx *c, Slice *sl) {
     c->fan = fan > NRULES ? NRULES : fan;
     if (r->kind != 0 && r->kind != HIT_FULL) { c->hit = *r; c->status = P_HIT; }
 }
+/* the next slice of a step for this thread to take (the threads share each step's slices
+   as they come free: a thread held up by other load holds up the round less); -1 when none */
+static inline int64_t ptake(const Ctx *c, int64_t *next) {
+    int64_t k = __atomic_fetch_add(next, 1, __ATOMIC_RELAXED);
+    return k < c->nslices ? k : -1;
+}
 void prun(Ctx *c, Slice *sl, int64_t t) {
-    int64_t sense = 0;
-    Slice *q = &sl[t];
+    int64_t sense = 0, k;
     for (;;) {
         if (t == 0) pplan(c, sl);
         pbarrier(c, &sense);
         if (c->status != P_RUN) return;
-        pexpand(c, q);
+        while ((k = ptake(c, &c->cexp)) >= 0) pexpand(c, &sl[k]);
         pbarrier(c, &sense);
-        q->kept = q->a < q->b;
-        for (int64_t u = 0; u < t; u++) if (sl[u].r.done < sl[u].b) q->kept = 0;
-        q->fresh = q->kept ? pmark(c, sl, t) : 0;
+        while ((k = ptake(c, &c->cmark)) >= 0) {
+            Slice *q = &sl[k];
+            q->kept = q->a < q->b;
+            for (int64_t u = 0; u < k; u++) if (sl[u].r.done < sl[u].b) q->kept = 0;
+            q->fresh = q->kept ? pmark(c, sl, k) : 0;
+        }
         pbarrier(c, &sense);
         if (t == 0) psettle(c, sl);
         pbarrier(c, &sense);
-        if (q->kept) pinsert(c, sl, t);
-        for (int64_t d = 0; d < q->r.distinct; d++) q->ltable[q->clocal[d]] = -1;   /* empty again */
-        q->r.distinct = 0;
-        if (!q->kept) q->r.edges = 0;
+        while ((k = ptake(c, &c->cins)) >= 0) {
+            Slice *q = &sl[k];
+            if (q->kept) pinsert(c, sl, k);
+            for (int64_t d = 0; d < q->r.distinct; d++) q->ltable[q->clocal[d]] = -1;   /* empty again */
+            q->r.distinct = 0;
+            if (!q->kept) q->r.edges = 0;
+        }
     }
 }"""
 
