@@ -243,11 +243,12 @@ out:
 # The parallel search (model_check.parallel): `prun`, called on every thread at once (thread t),
 # runs rounds over `bfs`'s hash table and rows until the search ends, a hit, `rounds` rounds, or
 # arrays to grow; threads meet at barriers in C (no Python between the steps). A round: thread 0
-# cuts the next states into consecutive slices, one per thread; then each thread
-# - expands its slice against the table as it is, read only; a successor not in it becomes a
+# cuts the next states into consecutive slices (several per thread); then, the threads taking
+# the slices as they come free (ptake), each slice
+# - is expanded against the table as it is, read only; a successor not in it becomes a
 #   candidate, deduplicated in the slice's own table, with its hash and where its probe of the
 #   shared table stopped (slot, step);
-# - (kept if every slice before it finished) marks its candidates: one an earlier slice has too is
+# - (kept if every slice before it finished) has its candidates marked: one an earlier slice has too is
 #   that slice's (the earliest), the others are new, numbered in first-seen order;
 # - (thread 0: each slice's base id is the stored states plus the new ones of the slices before)
 #   writes each new candidate's row and parent at base + number and claims a table slot for its

@@ -8,8 +8,9 @@ final checks and counterexamples run on it unchanged. The search goes in rounds,
 in C (native.py `prun`, called on every thread; the threads meet at barriers in C):
 
 1. thread 0 cuts the next stored states (they may run on into the next layer) into
-   consecutive slices, one per thread;
-2. every thread expands its slice against the table as it is (read only): an edge to a
+   consecutive slices, SLICES per thread; in each step below the threads take the slices as
+   they come free, so a thread held up by other load holds the round up less;
+2. each slice is expanded against the table as it is (read only): an edge to a
    stored state gets its id; a successor not stored becomes a candidate of the slice,
    deduplicated in the slice's own table;
 3. a candidate an earlier slice has too is that slice's; the others are new, numbered in
