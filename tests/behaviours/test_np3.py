@@ -47,15 +47,18 @@ def test_init_starts_the_task_and_a_whisker_contact_backs_off_within_the_reactio
     rig.run(1.0)
     assert moves(rig) == [(pytest.approx(0.05, abs=0.05), MovCmd.FORWARD)]
     rig.inject(2.0, MCP, data("TPSC", int(TpscContact.OBJ_BOTH)))          # head-on contact
-    rig.run(7.0)
+    manoeuvre = T.NP3_CONTACT_BACK_S + (90 + T.NP3_CONTACT_CLEAR_DEG) / T.NP3_DR_TURN_DEG_S   # back, turn ~110 deg
+    end = 2.0 + manoeuvre + 0.5 + 0.5                  # the 0.5 s hold and a little more
+    rig.run(end)
     after = [(t, m) for t, m in moves(rig) if t >= 2.0]
     assert after[0][1] == MovCmd.BACKWARD and after[0][0] - 2.0 < 0.1     # seed 5.2: well within 1 s
     assert any(m in (MovCmd.TURN_LEFT, MovCmd.TURN_RIGHT) for _t, m in after[1:])
-    assert command_at(rig, 7.0) == MovCmd.FORWARD         # back to the task after 1.6 + 2.4 s and the 0.5 s hold
+    assert command_at(rig, end - 1.0) != MovCmd.FORWARD   # still turning away from the surface ahead
+    assert command_at(rig, end) == MovCmd.FORWARD         # back to the task after the manoeuvre and the hold
     metrics = rig.node.debug_metrics()
     assert set(metrics["control"]) == {"task", "reflexes"}
-    assert sum(metrics["control"].values()) == pytest.approx(7.0 - 0.05, abs=0.15)
-    assert metrics["control"]["reflexes"] == pytest.approx(1.6 + 2.4 + 0.5, abs=0.15)
+    assert sum(metrics["control"].values()) == pytest.approx(end - 0.05, abs=0.15)
+    assert metrics["control"]["reflexes"] == pytest.approx(manoeuvre + 0.5, abs=0.15)
     assert metrics["switches"] == 2 and metrics["takeovers"]["contact"] == 1
 
 
