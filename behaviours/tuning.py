@@ -66,6 +66,8 @@ JAC_WATCHDOG_S = 1.0          # no set point this long (5 refresh periods): the 
 
 # --- NP3 (seed 3.2.3, 3.3.2, 5.1-5.2, 6, docs/decisions.md D8): the subsumption network's numbers, all CHOICE
 NP3_PERIOD_S = 0.1            # the network is evaluated every 100 ms (5.2: reactions well within 1 s)
+NP3_START_LOOK_S = 1.0        # after INIT no step until the IR and whiskers reported (the SPU polls them first, see
+                              # SPU_FIRST_POLL), at most this long
 NP3_REFLEX_HOLD_S = 0.5       # suppressor time constants: reflexes ...
 NP3_AVOID_HOLD_S = 0.3        # ... and obstacle avoidance keep the lower layers cut this long
 NP3_CONTACT_BACK_S = 1.6      # contact (whisker, IR very close) with the surface ahead: back off at least one
@@ -143,6 +145,7 @@ NP3_WALL_LOST_S = 8.0         # ... no wall beside for this long: turn right to 
 
 # --- SPU (seed 3.2.5): polling order, status checks, alarms and forwarding rate limits to the NP3 (all CHOICE)
 SPU_CYCLE = ("IRRC", "LSC", "IRRC", "ISC", "IRRC", "TSC", "IRRC", "PSC")  # IR every 2nd poll (5.2); USRC free-runs
+SPU_FIRST_POLL = ("IRRC", "TPSC")  # after POST, before the alarm set-up: what touches or almost touches the body
 SPU_STATUS_EVERY_S = 0.5      # one STATUS_REQ to a range sensor (USRC, IRRC in turn) this often (6.2)
 SPU_SILENT_POLLS = 1          # failed transactions in a row (each with the retry) before OUT_OF_ORDER: the seed 3.2.2 rule
 SPU_XMIT_RETRY_S = 0.3        # a pending record not granted this long: XMIT_REQ again (the request may be lost)
