@@ -750,7 +750,8 @@ def np3_network(clock: Clock, task: str = "forward", tuning: Tuning | None = Non
     net = Network(clock)
     reflexes = [   # level 0; declared weakest first: a later suppressor sits closer to the MMC and wins
         ReflexModule("leg_blocked", REFLEXES, ("leg_blocked",), leg_blocked_trigger(t)),   # seed 6.1
-        ReflexModule("contact", REFLEXES, ("whisker", "ir", "pose", "echoes"), contact_trigger(t)),          # seed 3.2.12, 3.2.13, 5.2
+        ReflexModule("contact", REFLEXES, ("whisker", "ir", "pose", "echoes"),
+                     contact_trigger(t)),                                                  # seed 3.2.12, 3.2.13, 5.2
         ReflexModule("pit", REFLEXES, ("pit",), pit_trigger(t)),                           # seed 1.2.2
         ReflexModule("tilt", REFLEXES, ("tilt",), tilt_trigger(t)),                        # seed 3.2.14
         ReflexModule("ir_fault", REFLEXES, ("ir_fault",), stop_while("ir_fault")),        # seed 6.2: IR -> stop
