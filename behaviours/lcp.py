@@ -25,7 +25,9 @@ contact first searches down for the ground (up to LCP_GROUND_SEARCH_M below its
 set point: the body may stand on a foot that rests on a low obstacle); still
 without contact LCP_SETTLE_S after touchdown it reports NO_GROUND and hovers at
 LCP_NO_GROUND_Z_M instead of pushing down into the pit; the flag clears
-when the sole touches ground again.
+when the sole touches ground again, or the foot swings to land elsewhere. A foot
+that did not get down (its JACs put it above LCP_GROUND_REACHED_M: it rests
+against a wall's or an obstacle's face) is not over a pit.
 """
 from __future__ import annotations
 
@@ -146,6 +148,7 @@ class LCP(PostMaster, Runtime, LcpSkeleton):
         dur = msg.duration / 1000
         self.deferred = None
         if msg.phase == _SWING:
+            self.flags &= ~_NO_GROUND         # the foot steps elsewhere: where it lands is judged anew
             in_air = old is not None and old.swing
             if self.high_steps > 0 and not in_air:
                 self.high_steps -= 1
@@ -200,8 +203,10 @@ class LCP(PostMaster, Runtime, LcpSkeleton):
             # reach down for the ground before calling it a pit (a sole switch only sees touch)
             self.search_z = max(-T.LCP_GROUND_SEARCH_M, self.search_z - T.LCP_GROUND_SEARCH_M_S * period)
         elif (self.carrying() and t - max(self.touchdown, self.lost_contact) > T.LCP_SETTLE_S
-              and not self.flags & _NO_GROUND):
-            self.flags |= _NO_GROUND          # seed 1.2.2: the sole finds no ground (a pit)
+              and not self.flags & _NO_GROUND and self.measured_foot()[2] <= T.LCP_GROUND_REACHED_M):
+            # seed 1.2.2: the sole finds no ground (a pit) where the foot got down to; a foot held up above
+            # that (on an obstacle's face: its JACs say where it is) is not over a pit (issue 17/18)
+            self.flags |= _NO_GROUND
             self.hw.note("no_ground", leg=self.leg)
         x, y, z = seg.at(t + period) if seg is not None else self.pos
         if self.carrying() and not self.flags & _NO_GROUND:
@@ -295,6 +300,13 @@ class LCP(PostMaster, Runtime, LcpSkeleton):
         self.seg = Segment(back, seg.end, self.now, left, swing=True, lift=self.high_lift())
         self.seg.blocked = True
 
+    def measured_foot(self) -> tuple[float, float, float]:
+        """The foot where its JACs last reported their angles (a joint not polled yet: where it was sent)."""
+        q = list(ik(self.cfg.geometry, self.leg, *self.pos))
+        for joint, angle in self.measured.items():
+            q[joint - 1] = angle
+        return fk(self.cfg.geometry, self.leg, *q)
+
     def halt_stalled(self) -> None:
         """seed 3.2.10: the LCP watches for collisions along the whole trajectory, not only in a swing (6.1).
         A foot that stalls while it is set down, held or hovering stops where its JACs say it is: a servo
@@ -302,12 +314,10 @@ class LCP(PostMaster, Runtime, LcpSkeleton):
         limit (issue 18). The next LEG_TARGET starts from here. No BLOCKED flag: that is the swing's rule
         (6.1), and a flag would make the NP3 step aside at every touch of a set-down foot."""
         self.stall_start = self.stall_seen = -math.inf
-        g = self.cfg.geometry
-        q = list(ik(g, self.leg, *self.pos))  # a joint not polled yet: where it was sent
-        for joint, angle in self.measured.items():
-            q[joint - 1] = angle
-        here = fk(g, self.leg, *q)
-        self.seg, self.deferred, self.pos = Segment(here, here, self.now, 0.0), None, here
+        here = self.measured_foot()
+        # a foot meant to carry is set down straight from there (down a wall's face, not hanging on it)
+        end = (here[0], here[1], 0.0) if self.carrying() else here
+        self.seg, self.deferred, self.pos = Segment(here, end, self.now, T.LCP_SET_DOWN_S), None, here
         self.stall_holds += 1
         self.hw.note("stall_hold", leg=self.leg)
 

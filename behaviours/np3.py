@@ -133,6 +133,8 @@ class NP3(Runtime, Np3Skeleton):
         self.takeovers: dict[str, int] = {}
         # registers and what the records told so far
         self.ir: list[float | None] = [None, None, None]
+        self.heard: set[str] = set()          # roles that sent a record since power-on
+        self.look_until = math.inf            # no step before the IR and whiskers reported, or until then (seed 5.2)
         self.tilt = [0.0, 0.0]
         self.seq = {"whisker": 0, "pit": 0, "leg_blocked": 0, "light": 0, "sound": 0, "veto": 0}
         self.escape_plans: dict[str, Any] = {}   # module -> its manoeuvre last noted as an escape window (5.2)
@@ -154,6 +156,7 @@ class NP3(Runtime, Np3Skeleton):
         """seed 3.2.3: INIT from the MCP after POST starts navigation with a zeroed world model."""
         if not self.running:
             self.running = True
+            self.look_until = self.now + T.NP3_START_LOOK_S
             self.hw.note("nav_start")          # 5.2: from here on the robot can act on what it senses
             self.tick()
 
@@ -178,6 +181,8 @@ class NP3(Runtime, Np3Skeleton):
             if now >= self.next_plan or (goal is not None and math.hypot(goal[0] - x, goal[1] - y)
                                          < T.NP3_GOAL_REACHED_M):
                 self.plan_goal(now)
+        if not self.heard.issuperset(T.SPU_FIRST_POLL) and now < self.look_until:
+            return       # seed 5.2: switched on next to a wall, the first step waits for what IR and whiskers sense
         cmd = self.layers.step()["move"]
         if cmd is not None and self.refused(int(cmd), (x, y, th)):
             cmd = self.layers.step()["move"]          # the guard reflex now holds the actuator
@@ -318,6 +323,7 @@ class NP3(Runtime, Np3Skeleton):
             return
         self.records += 1
         role, kind, ch, v = NODES[msg.address].role, msg.kind, msg.channel, msg.value
+        self.heard.add(role)
         urgent = True
         if role == "MMC" and kind == _STATUS:
             self.mmc_status(ch, v)

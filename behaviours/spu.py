@@ -102,6 +102,7 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
         self.posting = False
         self.polling = False
         self.cycle_i = self.status_i = 0
+        self.polled: str | None = None      # the role of the poll cycle's last XMIT_DATA
         self.next_status = 0.0
         self.counts = {"value": 0, "alarm": 0, "status": 0, "ignored": 0, "silent": 0, "untrusted": 0, "coalesced": 0}
         self.values: dict[str, int] = {}
@@ -120,6 +121,10 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
     def post_done(self, missing: list[int]) -> None:
         self.posting = False
         self.live = [r for r, a in self.sensors.items() if a not in missing]
+        for role in T.SPU_FIRST_POLL:  # seed 5.2: the close range first (a wall touched at power-on: the TPSC's
+            if role in self.live:      # DATA_RDY then found no SPU to fetch it); the NP3 does not step before
+                self.request(self.sensors[role], M.XmitData(), (XMIT_DATA_OF[role],),
+                             lambda s, m, role=role: self.got(role, m, False), lambda role=role: self.missed(role))
         # seed 3.2.13-3.2.17: the SPU sets up the alarm limits of every sensor present
         for role, msg, limits in alarm_setup():
             if role in self.live:
@@ -152,6 +157,7 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
             return
         role = cycle[self.cycle_i % len(cycle)]
         self.cycle_i += 1
+        self.polled = role
         self.request(self.sensors[role], M.XmitData(), (XMIT_DATA_OF[role],),
                      lambda s, m, role=role: (self.got(role, m, False), self.poll()),
                      lambda role=role: (self.missed(role), self.poll()))
@@ -173,7 +179,7 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
             return
         # spec reflexes (seed 5.2): a reflex source's data is fetched before anything still waiting out its defer
         priority = max(PRIORITY_REFLEX if self.net.reflex_from(src) is not None else 0, 1)
-        if self.waiting(src, M.XmitData, priority):
+        if self.waiting(src, M.XmitData, 0 if role in self.free_run else priority):   # its fetch may wait its turn
             # seed 3.2.2 / arbitration model: one request per slave, served in the order they got through. An urgent
             # fetch still waiting gets the newest data; queueing one per DATA_RDY let the free-running USRC pile up
             # nine and every other sensor wait behind them (worst_contention seed 6: past K on the sensor bus)
@@ -183,8 +189,12 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
             if self.status.get(role, _IN_ORDER) != _IN_ORDER:
                 self.counts["ignored"] += 1       # seed 6.2: an untrustworthy sensor's data is ignored
                 return
+            # seed 5.2: ahead of the poll cycle, but not of a poll already waiting: the USRC announcing close
+            # echoes every ~0.12 s kept the IR poll behind a new fetch for 2.7 s while the robot walked into a
+            # corner (start_in_corner); now the fetches and the polls take turns
+            polling = self.polled is not None and self.waiting(self.sensors[self.polled], M.XmitData)
             self.request(src, M.XmitData(), (XMIT_DATA_OF[role],), lambda s, m, role=role: self.got(role, m, False),
-                         lambda role=role: self.missed(role), urgent=True)
+                         lambda role=role: self.missed(role), urgent=not polling)
             return
         event = role != "TPSC"                     # anything else announces an alarm or a status change
         if role in RANGE:                          # its status first: is the data to be trusted (6.2)

@@ -36,6 +36,7 @@ LCP_SETTLE_S = 0.3            # a carrying foot without sole contact this long (
 LCP_SET_DOWN_S = 0.15         # a stance target reaching a foot still in the air: it is set down within this time
 LCP_GROUND_SEARCH_M = 0.03    # CHOICE: a carrying foot without contact reaches this far down before "no ground"
 LCP_GROUND_SEARCH_M_S = 0.1   # CHOICE: how fast it reaches down (m/s)
+LCP_GROUND_REACHED_M = 0.01  # a foot without contact is over a pit only if its JACs put it this low (else: on a face)
 LCP_NO_GROUND_Z_M = 0.03      # seed 1.2.2: over a pit the foot hovers this high and carries no weight
 LCP_MIN_SPEED_DEG_S = 30.0    # slowest commanded joint speed: a joint catches up after a lost set point
 LCP_SPEED_MARGIN = 2.0        # commanded speed = this x the speed needed to arrive within one period
@@ -65,11 +66,19 @@ JAC_WATCHDOG_S = 1.0          # no set point this long (5 refresh periods): the 
 
 # --- NP3 (seed 3.2.3, 3.3.2, 5.1-5.2, 6, docs/decisions.md D8): the subsumption network's numbers, all CHOICE
 NP3_PERIOD_S = 0.1            # the network is evaluated every 100 ms (5.2: reactions well within 1 s)
+NP3_START_LOOK_S = 1.0        # after INIT no step until the IR and whiskers reported (the SPU polls them first, see
+                              # SPU_FIRST_POLL), at most this long
 NP3_REFLEX_HOLD_S = 0.5       # suppressor time constants: reflexes ...
 NP3_AVOID_HOLD_S = 0.3        # ... and obstacle avoidance keep the lower layers cut this long
-NP3_CONTACT_BACK_S = 1.6      # contact (whisker, IR very close): back off one tripod cycle ...
-NP3_CONTACT_TURN_S = 2.4      # ... then turn away (about 60 degrees)
-NP3_CONTACT_SIDE_TURN_S = 1.6 # one whisker only, IR clear: just turn away (about 40 degrees)
+NP3_CONTACT_BACK_S = 1.6      # contact (whisker, IR very close) with the surface ahead: back off at least one
+                              # tripod cycle (longer if the body's corners would sweep into it turning) ...
+NP3_CONTACT_AHEAD_DEG = 60.0  # ... "ahead": its normal (IR line fit) within this of the heading ...
+NP3_CONTACT_CLEAR_DEG = 20.0  # ... then turn until the surface's normal is this far behind the side (walk away),
+NP3_CONTACT_MIN_TURN_DEG = 30.0   # ... at least this far;
+NP3_CONTACT_WHISKER_NORMAL_DEG = 60.0  # a whisker alone (IR beams clear): the surface taken to face this far aside
+NP3_CONTACT_CORNER_M = 0.01   # the IR centre point this far behind the line through the side points: a corner;
+NP3_CONTACT_CORNER_NORMAL_DEG = 45.0  # ... the side beams alone see a corner: its walls taken to face this far aside
+NP3_CONTACT_NEAR_M = 0.1      # ... a remembered echo beside the body this close to it: a wall alongside
 NP3_IR_CONTACT_M = 0.03       # an IR echo this close counts as contact
 NP3_AVOID_CENTRE_M = 0.08     # avoidance: the centre beam sees something this close ...
 NP3_AVOID_SIDE_M = 0.06       # ... or a side beam this close -> turn away
@@ -136,6 +145,7 @@ NP3_WALL_LOST_S = 8.0         # ... no wall beside for this long: turn right to 
 
 # --- SPU (seed 3.2.5): polling order, status checks, alarms and forwarding rate limits to the NP3 (all CHOICE)
 SPU_CYCLE = ("IRRC", "LSC", "IRRC", "ISC", "IRRC", "TSC", "IRRC", "PSC")  # IR every 2nd poll (5.2); USRC free-runs
+SPU_FIRST_POLL = ("IRRC", "TPSC")  # after POST, before the alarm set-up: what touches or almost touches the body
 SPU_STATUS_EVERY_S = 0.5      # one STATUS_REQ to a range sensor (USRC, IRRC in turn) this often (6.2)
 SPU_SILENT_POLLS = 1          # failed transactions in a row (each with the retry) before OUT_OF_ORDER: the seed 3.2.2 rule
 SPU_XMIT_RETRY_S = 0.3        # a pending record not granted this long: XMIT_REQ again (the request may be lost)

@@ -4,8 +4,10 @@ Feet are kinematic points: a foot on the ground stays where it touched down
 (its anchor), and each physics step the body pose is the least-squares rigid
 transform that best keeps the stance feet on their anchors. The chassis is a
 pymunk shape, used only to detect contact with walls and tall obstacles: a
-move into one is refused (the feet slip). A swing foot that runs into a solid
-taller than itself stops there and its servos draw stall current (seed 6.1).
+move into one is refused (the feet slip). A foot in the air that runs into a
+solid taller than itself slides along its face and down it; where the face
+refuses more of the move than the foot makes, the servos draw stall current
+(seed 6.1: the LCP sees the leg blocked).
 
 Servos (seed 3.2.18): the JAC drives each one with a speed command
 (`set_joint_drive`, rad/s, limited by the servo's top speed) and closes the
@@ -22,14 +24,15 @@ from dataclasses import dataclass, field
 import pymunk
 
 from behaviours.kinematics import fk, ik
-from sim2d.geometry import WALL_RADIUS, Pt, convex_hull, inside_convex, rigid_fit, to_world
+from sim2d.geometry import Pt, convex_hull, inside_convex, rigid_fit, to_body, to_world
 from sim2d.robot_params import RobotParams
 from sim2d.world import BODY, OBSTACLE, WALL, World
 
 CONTACT_EPS = 0.002   # a foot within 2 mm of the ground touches it
 DEPTH_EPS = 1e-6      # a swing foot moving this much further into a solid's footprint is blocked
 LEG_REACH = 0.45      # body centre to the farthest foot, with margin
-SLIDE_M = 0.005       # a foot lowered along a wall it touches may drift this far sideways per step
+SLIDE_SPEED = 0.05    # m/s: a foot pushing into a face that moves slower than this (along it or down) stalls
+FACE_FRICTION = 0.5   # CHOICE: a foot slides along a face only if its move along it exceeds this x its push into it
 
 
 @dataclass
@@ -213,29 +216,12 @@ class Robot:
                 ground = 0.0                      # fast path: nothing around can touch this foot
                 leg.over_pit = False
             else:
-                wx, wy = leg.world
-                ground = self.world.ground_height(wx, wy)
+                under = math.inf
                 if not was and moving and self.world.has_solids:
-                    hip = to_world(self.pose, *self.p.hip(leg.index))     # a wall is deeper the further from the hip
-                    solid = self.world.solid_at(wx, wy, hip)
-                    # from the side (the foot was below the top before): it hits the obstacle;
-                    # from above: it lands on top (contact below). A foot the body carried into a
-                    # footprint while it was in the air is not stuck there: only a move that takes it
-                    # into the solid, or deeper, is stopped (it lifts or slides out). A foot pressed
-                    # against a wall's face still slides down it: lowering (with at most SLIDE_M of
-                    # sideways drift) is not a hit, else it would hang there and report no ground
-                    # - but never past a wall's centre line (issue 18: behind it, it stalls on every move back)
-                    sliding = (fz < old_foot[2] and math.dist(leg.world, old_world) < SLIDE_M
-                               and solid.depth <= WALL_RADIUS)
-                    if (solid.height > fz + CONTACT_EPS and old_foot[2] < solid.height - CONTACT_EPS
-                            and solid.depth > self.world.solid_at(*old_world, hip).depth + DEPTH_EPS
-                            and not sliding):
-                        # seed 6.1: the swing foot hits an obstacle; the servos stall
-                        for j, a in zip(leg.joints, old):
-                            j.angle, j.speed = a, 0.0
-                        leg.foot, leg.world = old_foot, old_world
-                        leg.blocked = True
-                        self.events.blocked_legs += 1
+                    self._meet_solids(leg, old, old_foot, old_world, dt)
+                    # a foot in the air that met an obstacle too tall to step onto is at its face, not on it
+                    under = max(old_foot[2] + CONTACT_EPS, p.step_limit)
+                ground = self.world.ground_height(*leg.world, under)
                 leg.over_pit = ground is None
             leg.contact = ground is not None and leg.foot[2] <= ground + CONTACT_EPS
             if leg.contact and not was:
@@ -260,6 +246,53 @@ class Robot:
         stalled = [(leg.index, k) for leg in self.legs.values() for k, j in enumerate(leg.joints, 1)
                    if j.current >= p.servo_stall_a]
         self.battery_log.add(self.battery_voltage(), total_current, stalled)
+
+    def _meet_solids(self, leg: Leg, old: list[float], old_foot: tuple[float, float, float], old_world: Pt,
+                     dt: float) -> None:
+        """A foot in the air that moves into a wall or obstacle taller than itself.
+
+        From the side (the foot was below the top before) it meets a face; from above it lands on top (contact,
+        below). A foot the body carried into a footprint while it was in the air is not stuck there: only a move
+        that takes it into the solid, or deeper, meets the face. There the foot slides along the face and down
+        it: only the part of the move into the face is refused (issue 17/18: a foot hung on a wall's face found
+        no ground and read as a pit; a foot set down beside a wall stalled on its face). A foot that barely moves
+        (slower than SLIDE_SPEED) while it pushes stalls its servos (seed 6.1: the swing is blocked)."""
+        fz = leg.foot[2]
+        hip = to_world(self.pose, *self.p.hip(leg.index))
+        solid = self.world.solid_at(*leg.world, hip)
+        if not (solid.height > fz + CONTACT_EPS and old_foot[2] < solid.height - CONTACT_EPS):
+            return
+        before = self.world.solid_at(*old_world, hip).depth + DEPTH_EPS
+        if solid.depth <= before:
+            return
+        (ox, oy), (wx, wy), (nx, ny) = old_world, leg.world, solid.normal
+        dx, dy = wx - ox, wy - oy
+        into = min(0.0, dx * nx + dy * ny)                      # the push into the face (normal: out of it)
+        tx, ty = dx - into * nx, dy - into * ny                 # ... and the part along it
+        made, refused = 0.0, math.dist(old_world, leg.world)
+        # friction: a foot meeting the face more squarely than the friction cone allows does not slide along it
+        slides = math.hypot(tx, ty) >= FACE_FRICTION * -into
+        for cx, cy in ([(ox + tx, oy + ty)] if slides else []) + [old_world]:   # along the face; straight down
+            if self.world.solid_at(cx, cy, hip).depth > before:
+                continue
+            q = ik(self.p, leg.index, *to_body(self.pose, cx, cy), fz)
+            foot = fk(self.p, leg.index, *q)
+            moved = to_world(self.pose, foot[0], foot[1])
+            if self.world.solid_at(*moved, hip).depth > before:
+                continue                                        # the leg's reach clamped it back into the face
+            made = math.dist(moved, old_world) + abs(foot[2] - old_foot[2])
+            refused = math.dist(moved, leg.world) + abs(foot[2] - fz)
+            for j, a, b in zip(leg.joints, q, old):
+                j.angle, j.speed = a, (a - b) / dt
+            leg.foot, leg.world = foot, moved
+            break
+        else:
+            for j, a in zip(leg.joints, old):
+                j.angle, j.speed = a, 0.0
+            leg.foot, leg.world = old_foot, old_world
+        if refused > 0.0 and made < SLIDE_SPEED * dt:
+            leg.blocked = True                                  # seed 6.1: the swing foot hits an obstacle
+            self.events.blocked_legs += 1
 
     def _move_body(self) -> None:
         stance = [leg for leg in self.legs.values() if leg.contact and leg.anchor is not None]

@@ -22,9 +22,11 @@ WALL_ONLY = pymunk.ShapeFilter(mask=WALL)
 
 
 class SolidHit(NamedTuple):
-    """A wall or obstacle at a point: its height, and the point's depth inside its footprint (0: outside)."""
+    """A wall or obstacle at a point: its height, the point's depth inside its footprint (0: outside) and the
+    outward normal of the face it is measured from (a foot pressed into that face slides along it)."""
     height: float
     depth: float
+    normal: Pt = (0.0, 0.0)
 
 
 def _bbox(poly: tuple[Pt, ...]) -> tuple[float, float, float, float]:
@@ -82,14 +84,15 @@ class World:
         return best
 
     # --- ground -----------------------------------------------------------
-    def ground_height(self, x: float, y: float) -> float | None:
-        """Height of the ground a foot finds at (x, y); None over a pit (no ground)."""
+    def ground_height(self, x: float, y: float, under: float = math.inf) -> float | None:
+        """Height of the ground a foot finds at (x, y); None over a pit (no ground). Obstacles taller than `under`
+        do not count: a foot in the air below their top is at their side (on a face), not on them."""
         for pit in self.scenario.pits:
             if point_in_polygon(x, y, pit):
                 return None
         top = 0.0
         for ob in self.scenario.obstacles:
-            if point_in_polygon(x, y, ob.polygon):
+            if ob.height <= under and point_in_polygon(x, y, ob.polygon):
                 top = max(top, ob.height)
         return top
 
@@ -100,26 +103,26 @@ class World:
     def solid_at(self, x: float, y: float, seen_from: Pt | None = None) -> SolidHit:
         """The solid occupying (x, y): its height and how far (x, y) lies inside its footprint.
 
-        A wall is a thin segment, so the distance into it alone cannot tell a point that went in from one that
-        came through: `seen_from` (a leg's hip) counts a wall's depth from that side, on through and past its
-        centre line. A foot whose move takes it deeper is stopped (sim2d.robot); without the side, a foot that
-        crossed the centre line got shallower, passed behind the wall and then stalled its servos on every move
-        back into the room (issue 18, explore seed 2)."""
+        A wall, or a thin obstacle, is too thin for the distance into it alone to tell a point that went in from
+        one that came through: `seen_from` (a leg's hip) counts the depth from the face the line from there
+        enters by, on through and past the solid's middle. A foot whose move takes it deeper is stopped
+        (sim2d.robot); without the side, a foot that crossed a wall's centre line got shallower, passed behind
+        the wall and then stalled its servos on every move back into the room (issue 18, explore seed 2).
+        Thin, tall polygon obstacles are measured the same way (issue 18's leftover)."""
         q = self.space.point_query_nearest((x, y), 0.0, SOLID)
-        hit = SolidHit(0.0, 0.0) if q is None else SolidHit(self.heights.get(q.shape, 0.0), max(0.0, -q.distance))
+        if q is None:
+            hit = SolidHit(0.0, 0.0)
+        else:
+            hit = SolidHit(self.heights.get(q.shape, 0.0), max(0.0, -q.distance), (q.gradient.x, q.gradient.y))
         if seen_from is None:
             return hit
-        for w in self.space.segment_query(seen_from, (x, y), 0.0, WALL_ONLY):
-            (ax, ay), (bx, by) = w.shape.a, w.shape.b
-            length = math.hypot(bx - ax, by - ay)
-            if length == 0.0:
-                continue
-            nx, ny = (ay - by) / length, (bx - ax) / length          # a unit normal of the wall's centre line
-            if (seen_from[0] - ax) * nx + (seen_from[1] - ay) * ny > 0:
-                nx, ny = -nx, -ny                                     # ... pointing away from `seen_from`
-            depth = WALL_RADIUS + (x - ax) * nx + (y - ay) * ny
+        for w in self.space.segment_query(seen_from, (x, y), 0.0, SOLID):
+            if w.alpha <= 0.0:
+                continue                                              # the hip is above it: the distance counts
+            (px, py), (nx, ny) = w.point, w.normal                    # where the line enters, the face's normal
+            depth = (px - x) * nx + (py - y) * ny
             if depth > hit.depth:
-                hit = SolidHit(self.heights.get(w.shape, WALL_HEIGHT), depth)
+                hit = SolidHit(self.heights.get(w.shape, WALL_HEIGHT), depth, (nx, ny))
         return hit
 
     def in_pit(self, x: float, y: float) -> bool:

@@ -13,7 +13,7 @@ from behaviours.geometry import DEFAULT_GEOMETRY as G
 from behaviours.kinematics import fk, ik, swing_point
 from behaviours.units import quantizer
 from tests.behaviours.rig import Rig
-from tests.behaviours.test_lcp_kinematics import JACS, commanded, jacs_answer
+from tests.behaviours.test_lcp_kinematics import JACS, commanded, jacs_answer, jacs_at_set_point
 
 MMC, LCP1 = 0x03, 0x21
 _FB_DEG = quantizer(M.JointFeedback, "angle")
@@ -114,7 +114,7 @@ def test_blocked_swing_retracts_retries_high_and_fails_when_blocked_again(spec):
 
 
 def test_no_ground_under_a_stance_foot_hovers_and_clears_on_contact(spec):
-    rig = Rig(spec, "LCP", LCP1, jacs_answer)
+    rig = Rig(spec, "LCP", LCP1, jacs_at_set_point())
     rig.run(1.0)
     stance(rig, 1.0, x=0, ms=3000)
     rig.run(1.0 + T.LCP_SETTLE_S - 0.1)
@@ -181,7 +181,9 @@ def _stuck_rig(spec, stalled) -> Rig:
 
 def _held_where_it_stuck(rig: Rig) -> None:
     _, last = commanded(rig)[-1]
-    assert fk(G, 1, *last) == pytest.approx(STUCK, abs=2e-3)    # held where it stuck, not pushed on to x=40 mm
+    # held where it stuck, not pushed on to x=40 mm, and set straight down from there (issue 17: a foot left
+    # hanging on a wall's face found no ground and read as a pit)
+    assert fk(G, 1, *last) == pytest.approx((STUCK[0], STUCK[1], 0.0), abs=2e-3)
     assert sum(1 for _, e, _ in rig.board.notes if e == "stall_hold") == 1
     assert rig.node.debug_metrics()["stall_holds"] == 1
     assert not rig.node.seg.swing and rig.node.seg.done(rig.board.t)
@@ -190,7 +192,7 @@ def _held_where_it_stuck(rig: Rig) -> None:
 def test_a_foot_stalled_outside_a_swing_stops_where_it_is(spec):
     """seed 3.2.10 / 6.1, issue 18: a foot set down or held against a wall stalls outside a swing. The LCP
     used to keep pushing it there at stall current for good (the servos cooked, a full battery sagged under
-    the PSC's alarm limit); now it holds the foot where the JACs report it."""
+    the PSC's alarm limit); now it stops the foot where the JACs report it and sets it straight down."""
     stalled = {"on": False}
     rig = _stuck_rig(spec, lambda n: stalled["on"])
     rig.run(1.3)
@@ -215,3 +217,14 @@ def test_a_leg_stalling_and_slipping_by_turns_is_stopped_too(spec):
     stalled["on"] = False
     rig.run(3.0)
     _held_where_it_stuck(rig)
+
+
+def test_a_foot_held_up_on_a_face_is_not_a_pit(spec):
+    """Issue 17/18 (start_at_wall seeds 9-10, fault_us_killed_explore seed 16): a foot caught on a wall's face
+    has no sole contact, but its JACs put it 2 cm up: something holds it, it is not over a pit."""
+    rig = _stuck_rig(spec, lambda n: False)
+    rig.board.sole = False
+    rig.run(1.0 + 4 * T.LCP_SETTLE_S)
+    r = report(rig, rig.board.t)
+    assert not r.flags & LegFlags.NO_GROUND and not r.flags & LegFlags.CONTACT
+    assert not any(e == "no_ground" for _, e, _ in rig.board.notes)

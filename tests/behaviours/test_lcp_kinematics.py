@@ -65,6 +65,20 @@ def jacs_answer(f):
     return []
 
 
+def jacs_at_set_point():
+    """JACs whose servos stand where they were last sent (the LCP reads the foot's height from them)."""
+    sent: dict[int, int] = {}
+
+    def respond(f):
+        m = f.message
+        if isinstance(m, M.JointTarget):
+            sent[f.dst] = m.angle
+        if isinstance(m, M.JointPoll):
+            return [(f.dst, M.JointFeedback(angle=sent.get(f.dst, 0), speed=0, current=50, temperature=31, flags=0))]
+        return jacs_answer(f)
+    return respond
+
+
 def commanded(rig: Rig) -> list[tuple[float, tuple[float, float, float]]]:
     """The joint angles (rad) the LCP has commanded, one complete set per control period, from the bytes it sent."""
     q = [None, None, None]

@@ -24,8 +24,16 @@ def grant(frame):
     return [(MCP, M.XmitGrant())] if isinstance(frame.message, M.XmitReq) else []
 
 
-def np3(spec, task: str = "forward") -> Rig:
+IR_CLEAR = quantizer(M.XmitDataIrrc, "center").hi     # an IR beam that sees nothing within its range
+
+
+def np3(spec, task: str = "forward", ir_first: bool = True) -> Rig:
+    """The NP3 with INIT at 0.05 s; `ir_first`: the SPU's first polls of the IR (nothing in range) and the
+    whiskers (no contact) reach it before (tuning.SPU_FIRST_POLL)."""
     rig = Rig(spec, "NP3", NP3, grant, task=task)
+    if ir_first:
+        rig.inject(0.03, MCP, data("IRRC", IR_CLEAR))
+        rig.inject(0.04, MCP, data("TPSC", 0))
     rig.inject(0.05, MCP, M.Init())
     return rig
 
@@ -47,16 +55,36 @@ def test_init_starts_the_task_and_a_whisker_contact_backs_off_within_the_reactio
     rig.run(1.0)
     assert moves(rig) == [(pytest.approx(0.05, abs=0.05), MovCmd.FORWARD)]
     rig.inject(2.0, MCP, data("TPSC", int(TpscContact.OBJ_BOTH)))          # head-on contact
-    rig.run(7.0)
+    manoeuvre = T.NP3_CONTACT_BACK_S + (90 + T.NP3_CONTACT_CLEAR_DEG) / T.NP3_DR_TURN_DEG_S   # back, turn ~110 deg
+    end = 2.0 + manoeuvre + 0.5 + 0.5                  # the 0.5 s hold and a little more
+    rig.run(end)
     after = [(t, m) for t, m in moves(rig) if t >= 2.0]
     assert after[0][1] == MovCmd.BACKWARD and after[0][0] - 2.0 < 0.1     # seed 5.2: well within 1 s
     assert any(m in (MovCmd.TURN_LEFT, MovCmd.TURN_RIGHT) for _t, m in after[1:])
-    assert command_at(rig, 7.0) == MovCmd.FORWARD         # back to the task after 1.6 + 2.4 s and the 0.5 s hold
+    assert command_at(rig, end - 1.0) != MovCmd.FORWARD   # still turning away from the surface ahead
+    assert command_at(rig, end) == MovCmd.FORWARD         # back to the task after the manoeuvre and the hold
     metrics = rig.node.debug_metrics()
     assert set(metrics["control"]) == {"task", "reflexes"}
-    assert sum(metrics["control"].values()) == pytest.approx(7.0 - 0.05, abs=0.15)
-    assert metrics["control"]["reflexes"] == pytest.approx(1.6 + 2.4 + 0.5, abs=0.15)
+    assert sum(metrics["control"].values()) == pytest.approx(end - 0.05, abs=0.15)
+    assert metrics["control"]["reflexes"] == pytest.approx(manoeuvre + 0.5, abs=0.15)
     assert metrics["switches"] == 2 and metrics["takeovers"]["contact"] == 1
+
+
+def test_switched_on_the_first_step_waits_for_what_the_ir_sees(spec):
+    """seed 5.2: next to a wall at power-on the robot must not walk before its close range is known: no MOVE
+    after INIT until the IR's and the whiskers' first records, at once after them; without, after NP3_START_LOOK_S."""
+    rig = np3(spec, ir_first=False)
+    rig.inject(0.3, MCP, data("IRRC", IR_CLEAR, channel=1))
+    rig.run(0.5)
+    assert moves(rig) == []                             # the IR alone: the whiskers may still touch something
+    rig.inject(0.6, MCP, data("TPSC", 0))
+    rig.run(1.0)
+    assert moves(rig)[0][1] == MovCmd.FORWARD and 0.6 < moves(rig)[0][0] <= 0.6 + T.NP3_PERIOD_S + 0.02   # next period
+    silent = np3(spec, ir_first=False)                  # the IRRC never reports (absent, or its bus broken)
+    silent.run(0.05 + T.NP3_START_LOOK_S - 0.1)
+    assert moves(silent) == []
+    silent.run(0.05 + T.NP3_START_LOOK_S + 0.15)
+    assert [m for _t, m in moves(silent)] == [MovCmd.FORWARD]
 
 
 def test_left_whisker_turns_right_without_backing_off(spec):
