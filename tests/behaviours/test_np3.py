@@ -11,7 +11,8 @@ from arachnae_proto.enums import MmcError, MovCmd, RangeStatus, RecordKind, Tpsc
 from arachnae_proto.network import ADDRESS_OF
 from behaviours import tuning as T
 from behaviours.np3 import DeadReckoning, decode
-from behaviours.np3_layers import TaskModule, Tuning, body_frame, clear_ahead, light_gradient, np3_network, wall_beside
+from behaviours.np3_layers import (LSC_STEP_LOG, TaskModule, Tuning, body_frame, clear_ahead, light_gradient, np3_network,
+                                   wall_beside)
 from behaviours.units import quantizer
 from tests.behaviours.rig import Rig
 
@@ -212,6 +213,33 @@ def test_seek_light_explores_towards_the_planned_goal_while_no_sample_shows_a_li
     task.plan = None
     out = task.step({"pose": (1.2, 1.2, 0.0), "goal": goal}, now)
     assert (out["move"] == MovCmd.TURN_RIGHT) == steers_to_goal
+
+
+def test_seek_light_darkness_holds_through_noise_ends_at_a_brighter_sample_and_not_at_a_bright_plateau():
+    """seed 3.2.16: a shaded room reads the ambient light give or take 2 LSC steps; that is dark (explore the
+    map) for as long as it lasts, not a gradient to climb. A sample 8 steps brighter (the lamp seen past the
+    wall's end) ends it; readings flat at the lamp (the LSC saturated) are not dark: the light is here."""
+    t = Tuning()
+    task = TaskModule("seek_light", t)
+    assert t.light_flat_log > 2 * LSC_STEP_LOG
+    noise = [0, 2, 1, 0, 2, 1, 0, 2, 1, 2, 0, 1, 2, 0, 2, 1]
+    seq = 0
+
+    def sample(log_lux: float) -> None:
+        nonlocal seq
+        seq += 1
+        x, y = 0.3 * (seq % 4), 0.3 * (seq // 4 % 4)          # spread in both directions: a fit is possible
+        task.step({"light": (seq, x, y, log_lux), "pose": (x, y, 0.0)}, 2.5 * seq)
+
+    for k, n in enumerate(noise):
+        sample(0.7 + n * LSC_STEP_LOG)
+        assert task.dark() == (k + 1 >= t.light_samples)       # dark from the first full set on, and it holds
+    assert task.gradient is None                               # no gradient fitted to the noise
+    sample(0.7 + 8 * LSC_STEP_LOG)
+    assert not task.dark()
+    for _k in range(2 * t.light_samples):                      # at the lamp: flat, but far above the ambient
+        sample(3.0)
+        assert not task.dark()
 
 
 def test_seek_light_walks_round_an_obstacle_on_one_side():
