@@ -175,6 +175,10 @@ class NP3(Runtime, Np3Skeleton):
             self.echoes.popleft()
         self.layers.sense(pose=(x, y, th), sonar_ahead_m=ahead[1] if fresh else None,
                           echoes=tuple(e[1:] for e in self.echoes))
+        if self.cfg.task in ("explore", "seek_light", "avoid_light"):   # the tasks that detour (TaskModule._detour)
+            g = self.map.grid
+            self.layers.sense(mapped=tuple((mx, my, 0.0, g.res / 2)
+                                           for mx, my in g.occupied_near(x, y, T.NP3_MAPPED_NEAR_M)))
         if self.cfg.task in ("explore", "seek_light"):     # seeking light explores while it is dark
             self.mark_visited(x, y)
             goal = self.goal

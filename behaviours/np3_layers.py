@@ -46,13 +46,15 @@ Trigger = Callable[[Mapping[str, Any], float], "Steps | None"]
 #   echoes ((x, y, seen_deg, arc_m), ...) obstacle points of the last seconds (sonar, IR, whiskers) at the DR
 #                                pose, seen at body angle seen_deg, somewhere within arc_m across the beam
 #   veto (seq, command)          the node's motion check refused the command the network chose: do this instead
+#   mapped ((x, y, 0, arc_m), ...) occupied cells of the topological map round the DR pose (3.3.2): what the
+#                                echo memory has let go of (a block walked along for longer than it keeps echoes)
 _BRIGHTNESS = next(f.conv for f in XmitDataLsc.FIELDS if f.name == "brightness")
 # seed 3.2.16: one step of the LSC's logarithmic brightness code in log10 lux (1/64 decade), from the spec
 LSC_STEP_LOG = math.log10(_BRIGHTNESS.to_phys(_BRIGHTNESS.hi) / _BRIGHTNESS.to_phys(_BRIGHTNESS.lo)) \
     / (_BRIGHTNESS.hi - _BRIGHTNESS.lo)
 
 SENSORS = ("whisker", "ir", "ir_fault", "pit", "tilt", "battery_low", "leg_blocked", "sonar_ahead_m", "light",
-           "pose", "goal", "sound", "echoes", "veto")
+           "pose", "goal", "sound", "echoes", "veto", "mapped")
 
 
 @dataclass(frozen=True)
@@ -426,7 +428,7 @@ def light_gradient(samples: list[tuple[float, float, float]], min_spread: float,
 class TaskModule:
     """Level 2: the current task (docs/decisions.md D8: wall following, seeking / avoiding light, exploring)."""
 
-    inputs = ("ir", "whisker", "light", "pose", "goal", "echoes")
+    inputs = ("ir", "whisker", "light", "pose", "goal", "echoes", "mapped")
     outputs = ("move",)
 
     def __init__(self, task: str, t: Tuning) -> None:
@@ -612,10 +614,13 @@ class TaskModule:
 
     def _detour(self, i: Mapping[str, Any], pose: tuple[float, float, float], bearing: float, now: float) -> float:
         """seed 5.1.2: the heading closest to `bearing` whose corridor (body and legs) the echoes of the last
-        seconds leave clear for t.light_clear_m; the side a detour took is kept for t.light_detour_hold_s
-        after the last blocked heading (round an obstacle on one side, no dithering at its corner)."""
+        seconds and the obstacles on the map (3.3.2) leave clear for t.light_clear_m; the side a detour took is
+        kept for t.light_detour_hold_s after the last blocked heading (round an obstacle on one side, no
+        dithering at its corner). The map matters at a long obstacle: the echo memory keeps its face only
+        for seconds, a heading it no longer shows blocked turned the robot back into the face and avoidance
+        turned it away again, for 50-100 s at seek_light's block (seeds 14, 16, issue 17)."""
         t = self.t
-        echoes = i.get("echoes")
+        echoes = tuple(i.get("echoes") or ()) + tuple(i.get("mapped") or ())
         if now > self.detour_until:
             self.detour_side = 0.0
         if not echoes:

@@ -118,6 +118,13 @@ class OccupancyGrid:
             self.seen[k] = 1
             self.barriers.add((i, j))
 
+    def occupied_near(self, x: float, y: float, radius_m: float) -> list[tuple[float, float]]:
+        """Centres of the occupied cells (walls, blocks, pit edges, refused slopes) within `radius_m` of (x, y):
+        what the map remembers round the robot after its short echo memory has let it go."""
+        (i0, j0), (i1, j1) = self.cell(x - radius_m, y - radius_m), self.cell(x + radius_m, y + radius_m)
+        return [c for j in range(max(0, j0), min(self.ny, j1 + 1)) for i in range(max(0, i0), min(self.nx, i1 + 1))
+                if self.state(i, j) == OCCUPIED and math.dist(c := self.centre(i, j), (x, y)) <= radius_m]
+
     def mark_free(self, x: float, y: float, radius_m: float) -> None:
         """The robot stands here: the cells under its body are free (and seen)."""
         i0, j0 = self.cell(x - radius_m, y - radius_m)

@@ -120,6 +120,8 @@ NP3_LIGHT_WEAVE_S = 8.0       # ... changing side this often (the fit needs samp
 NP3_LIGHT_CLEAR_M = 0.6       # ... on the heading nearest the target with this much clear in the echo memory,
 NP3_LIGHT_DETOUR_STEP_DEG = 20.0  # ... tried in steps this wide either side (bug-style round an obstacle)
 NP3_LIGHT_DETOUR_HOLD_S = 10.0   # ... keeping a detour's side this long after the last blocked heading
+NP3_MAPPED_NEAR_M = 1.0       # ... the map's occupied cells this near the robot count as obstacles too (3.3.2;
+                              # beyond light_clear_m plus the body's half length: what a detour heading can meet)
 NP3_LIGHT_FLAT_STEPS = 5      # seeking light: samples spanning fewer than this many LSC steps (1/64 decade, 3.6 %
                               # each, from the spec) show no light to climb (a lamp shaded by a wall): explore the map
                               # instead (3.3.2) until a sample is that much brighter. Measured, issue 17: at 5 lx

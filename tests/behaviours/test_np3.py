@@ -258,6 +258,26 @@ def test_seek_light_walks_round_an_obstacle_on_one_side():
     assert task._detour({"echoes": ()}, (0.0, 0.0, 0.0), 0.3, 20.0) == 0.3
 
 
+def test_a_detour_keeps_clear_of_the_mapped_obstacle_the_echo_memory_has_let_go():
+    t = Tuning()
+    wall = tuple((0.4, -0.6 + 0.05 * k, 0.0, 0.0) for k in range(25))     # the same wall, now only on the map
+    task = TaskModule("seek_light", t)
+    assert task._detour({"echoes": (), "mapped": ()}, (0.0, 0.0, 0.0), 0.0, 0.0) == 0.0
+    h = task._detour({"echoes": (), "mapped": wall}, (0.0, 0.0, 0.0), 0.0, 0.0)
+    assert abs(math.degrees(h)) >= 40
+    assert clear_ahead(body_frame(wall, (0.0, 0.0, h)), t.avoid_half_width_m) >= t.light_clear_m
+
+
+def test_the_node_senses_the_mapped_obstacles_round_it(spec):
+    metres = quantizer(M.XmitDataUsrc, "distance")
+    rig = np3(spec, task="seek_light")
+    for k in range(0, 360, 5):                                               # walls 0.8 m all round
+        rig.inject(0.1 + k / 400, MCP, data("USRC", metres.raw(0.8), VALUE, channel=k))
+    rig.run(2.0)
+    mapped = rig.node.layers.sensors["mapped"]
+    assert mapped and all(0.6 < math.hypot(mx, my) <= T.NP3_MAPPED_NEAR_M for mx, my, _s, _a in mapped)
+
+
 def test_dead_reckoning_counts_sidesteps():
     odo = DeadReckoning(0.1, math.radians(25), 0.08)
     odo.command(0.0, int(MovCmd.TURN_LEFT))

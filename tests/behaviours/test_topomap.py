@@ -313,3 +313,12 @@ def test_a_route_out_of_a_ring_of_pits_takes_its_one_gap():
         m.grid.mark_barrier(4.0, 1.6 + 0.1 * k)
     m.rebuild()
     assert m.route((3.0, 2.0), (5.2, 2.0)) is None
+
+
+def test_occupied_near_lists_the_occupied_cells_within_the_radius():
+    g = OccupancyGrid(0.0, 0.0, 4.0, 4.0, 0.1)
+    g.integrate(Reading(1.0, 2.0, 0.0, 0.0, 0.8))             # an echo 0.8 m east of (1, 2)
+    g.mark_barrier(1.0, 3.5)                                   # a pit edge 1.5 m north
+    near = g.occupied_near(1.0, 2.0, 1.0)
+    assert len(near) == 1 and abs(near[0][0] - 1.85) < 0.11 and abs(near[0][1] - 2.0) < 0.1
+    assert any(abs(y - 3.55) < 0.1 for _x, y in g.occupied_near(1.0, 2.0, 1.6))
