@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from typing import Any, Callable, Mapping, NamedTuple
 
 from arachnae_proto.enums import MovCmd
+from arachnae_proto.messages import XmitDataLsc
 
 from behaviours import tuning as T
 from behaviours.geometry import DEFAULT_GEOMETRY
@@ -46,8 +47,15 @@ Trigger = Callable[[Mapping[str, Any], float], "Steps | None"]
 #   echoes ((x, y, seen_deg, arc_m), ...) obstacle points of the last seconds (sonar, IR, whiskers) at the DR
 #                                pose, seen at body angle seen_deg, somewhere within arc_m across the beam
 #   veto (seq, command)          the node's motion check refused the command the network chose: do this instead
+#   mapped ((x, y, 0, arc_m), ...) occupied cells of the topological map round the DR pose (3.3.2): what the
+#                                echo memory has let go of (a block walked along for longer than it keeps echoes)
+_BRIGHTNESS = next(f.conv for f in XmitDataLsc.FIELDS if f.name == "brightness")
+# seed 3.2.16: one step of the LSC's logarithmic brightness code in log10 lux (1/64 decade), from the spec
+LSC_STEP_LOG = math.log10(_BRIGHTNESS.to_phys(_BRIGHTNESS.hi) / _BRIGHTNESS.to_phys(_BRIGHTNESS.lo)) \
+    / (_BRIGHTNESS.hi - _BRIGHTNESS.lo)
+
 SENSORS = ("whisker", "ir", "ir_fault", "pit", "tilt", "battery_low", "leg_blocked", "sonar_ahead_m", "light",
-           "pose", "goal", "sound", "echoes", "veto")
+           "pose", "goal", "sound", "echoes", "veto", "mapped")
 
 
 _IRRC = quantizer(XMIT_DATA_OF["IRRC"], "center")
@@ -103,7 +111,7 @@ class Tuning:
     light_weave_s: float = T.NP3_LIGHT_WEAVE_S
     light_detour_step_deg: float = T.NP3_LIGHT_DETOUR_STEP_DEG
     light_detour_hold_s: float = T.NP3_LIGHT_DETOUR_HOLD_S
-    light_flat_log: float = T.NP3_LIGHT_FLAT_LOG
+    light_flat_log: float = T.NP3_LIGHT_FLAT_STEPS * LSC_STEP_LOG
     turn_rate_deg_s: float = T.NP3_DR_TURN_DEG_S   # turn on the spot (measured; nominal 20 deg per 0.8 s)
     walk_speed_m_s: float = T.NP3_DR_SPEED_M_S
     body_half_length_m: float = T.NP3_BODY_FRONT_M
@@ -543,7 +551,7 @@ def light_gradient(samples: list[tuple[float, float, float]], min_spread: float,
 class TaskModule:
     """Level 2: the current task (docs/decisions.md D8: wall following, seeking / avoiding light, exploring)."""
 
-    inputs = ("ir", "whisker", "light", "pose", "goal", "echoes")
+    inputs = ("ir", "whisker", "light", "pose", "goal", "echoes", "mapped")
     outputs = ("move",)
 
     def __init__(self, task: str, t: Tuning) -> None:
@@ -563,6 +571,8 @@ class TaskModule:
         self.detour_until = -math.inf
         self.weave = 0.0
         self.weave_at: float | None = None
+        self.dark_level: float | None = None     # log lux of the flat samples while no light shows (dark())
+        self.dimmest = math.inf                  # the lowest log lux sampled (the room's ambient light)
 
     def step(self, inputs: Mapping[str, Any], now: float) -> Outputs:
         if self.task in ("seek_light", "avoid_light"):
@@ -653,15 +663,34 @@ class TaskModule:
             return
         self.light_seq = light[0]
         self.samples = (self.samples + [light[1:]])[-self.t.light_samples:]
+        if self.task == "seek_light":                 # avoiding light, a flat reading is where it wants to be
+            self._darkness()
+        if self.dark_level is not None:
+            return
         fit = light_gradient(self.samples, self.t.light_min_spread_m, self.gradient)
         if fit is not None and self.gradient is None:
             self.plan = None                          # the probe has done its job: head for the light now
         self.gradient = fit or self.gradient
 
-    def dark(self) -> bool:
-        """A full set of light samples that differ by less than light_flat_log: no gradient to follow."""
+    def _darkness(self) -> None:
+        """Enter or leave the dark state (dark()) with the newest sample."""
         logs = [s[2] for s in self.samples]
-        return len(logs) >= self.t.light_samples and max(logs) - min(logs) < self.t.light_flat_log
+        self.dimmest = min(self.dimmest, logs[-1])
+        flat = self.t.light_flat_log
+        if self.dark_level is None and len(logs) >= self.t.light_samples \
+                and max(logs) < min(logs) + flat and max(logs) < self.dimmest + flat:
+            self.dark_level = max(logs)               # no light to climb: the gradient so far was noise
+            self.gradient = None
+        elif self.dark_level is not None and logs[-1] >= self.dark_level + flat:
+            self.dark_level = None                    # a light shows: fit afresh, with no prior from the noise
+
+    def dark(self) -> bool:
+        """No light to follow: a full set of samples spanned less than light_flat_log (a few LSC steps of
+        noise) at the dimmest level seen (flat and bright is at the lamp, or the LSC saturated there: stay),
+        and no sample since has read that much brighter than they did. The hysteresis matters: a flat
+        reading's noise spans 1-3 steps, and a state that flipped with it sent the robot after a gradient of
+        noise (light_behind_wall seed 2, issue 17)."""
+        return self.dark_level is not None
 
     def _seek_light(self, i: Mapping[str, Any], now: float) -> MovCmd:
         return self._light(i, now, sign=1.0)
@@ -708,10 +737,13 @@ class TaskModule:
 
     def _detour(self, i: Mapping[str, Any], pose: tuple[float, float, float], bearing: float, now: float) -> float:
         """seed 5.1.2: the heading closest to `bearing` whose corridor (body and legs) the echoes of the last
-        seconds leave clear for t.light_clear_m; the side a detour took is kept for t.light_detour_hold_s
-        after the last blocked heading (round an obstacle on one side, no dithering at its corner)."""
+        seconds and the obstacles on the map (3.3.2) leave clear for t.light_clear_m; the side a detour took is
+        kept for t.light_detour_hold_s after the last blocked heading (round an obstacle on one side, no
+        dithering at its corner). The map matters at a long obstacle: the echo memory keeps its face only
+        for seconds, a heading it no longer shows blocked turned the robot back into the face and avoidance
+        turned it away again, for 50-100 s at seek_light's block (seeds 14, 16, issue 17)."""
         t = self.t
-        echoes = i.get("echoes")
+        echoes = tuple(i.get("echoes") or ()) + tuple(i.get("mapped") or ())
         if now > self.detour_until:
             self.detour_side = 0.0
         if not echoes:

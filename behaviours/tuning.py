@@ -111,6 +111,11 @@ NP3_EXPLORE_TURN_S = 2.4      # ... turning this long
 NP3_GOAL_REACHED_M = 0.4      # a goal this close (dead reckoning) is reached
 NP3_PLAN_MIN_PATH_M = 1.5    # explore: a route over the map to the nearest frontier at least this far (3.3.2) ...
 NP3_PLAN_MIN_FRONTIER = 20    # ... of at least this many cells (smaller ones are gaps between sonar beams)
+NP3_PLAN_EXCLUDE_M = 0.5      # ... committed to until no frontier cell is left this near it (explored) or no
+                              # route leads there; frontier cells this near a frontier given up on do not count
+NP3_PLAN_PROGRESS_M = 0.3     # ... and given up when its route has not shortened by this much ...
+NP3_PLAN_PATIENCE_S = 40.0    # ... for this long (4 replans: walked round walls at 0.09 m/s, a route shortens faster)
+NP3_PLAN_CHANGED_S = 1.0      # ... and planned again this soon after a pit or refused slope joins the map
 NP3_SEEK_FRONTIER_WEIGHT_M = 0.1  # seeking a light no sample shows: a frontier cell is worth this much path (the
                               # widest opening onto the unknown, where a lamp behind a wall is, before the nearest)
 NP3_HEADING_TOL_DEG = 20.0    # steering: turn on the spot while the goal is further off the axis than this
@@ -123,8 +128,13 @@ NP3_LIGHT_WEAVE_S = 8.0       # ... changing side this often (the fit needs samp
 NP3_LIGHT_CLEAR_M = 0.6       # ... on the heading nearest the target with this much clear in the echo memory,
 NP3_LIGHT_DETOUR_STEP_DEG = 20.0  # ... tried in steps this wide either side (bug-style round an obstacle)
 NP3_LIGHT_DETOUR_HOLD_S = 10.0   # ... keeping a detour's side this long after the last blocked heading
-NP3_LIGHT_FLAT_LOG = 0.02     # seeking light: samples spanning less than this (log10 lux, ~1 LSC step of 3.6 %)
-                              # show no light to climb (a lamp shaded by a wall): explore the map instead (3.3.2)
+NP3_MAPPED_NEAR_M = 1.0       # ... the map's occupied cells this near the robot count as obstacles too (3.3.2;
+                              # beyond light_clear_m plus the body's half length: what a detour heading can meet)
+NP3_LIGHT_FLAT_STEPS = 5      # seeking light: samples spanning fewer than this many LSC steps (1/64 decade, 3.6 %
+                              # each, from the spec) show no light to climb (a lamp shaded by a wall): explore the map
+                              # instead (3.3.2) until a sample is that much brighter. Measured, issue 17: at 5 lx
+                              # ambient a flat reading's noise spans 1-3 steps (1 step flipped "dark" on and off);
+                              # the lamp seen past a wall's end reads 6x-16x the ambient (40-60 steps)
 NP3_MAP_SIZE_M = 12.0         # topological map: a square this wide around the start ...
 NP3_MAP_CELL_M = 0.1          # ... in cells this wide
 NP3_SONAR_BEAM_DEG = 15.0     # width a sonar echo is spread over on the map (40 kHz transducer cone)

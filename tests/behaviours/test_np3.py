@@ -11,7 +11,8 @@ from arachnae_proto.enums import MmcError, MovCmd, RangeStatus, RecordKind, Tpsc
 from arachnae_proto.network import ADDRESS_OF
 from behaviours import tuning as T
 from behaviours.np3 import DeadReckoning, decode
-from behaviours.np3_layers import TaskModule, Tuning, body_frame, clear_ahead, light_gradient, np3_network, wall_beside
+from behaviours.np3_layers import (LSC_STEP_LOG, TaskModule, Tuning, body_frame, clear_ahead, light_gradient, np3_network,
+                                   wall_beside)
 from behaviours.units import quantizer
 from tests.behaviours.rig import Rig
 
@@ -242,6 +243,33 @@ def test_seek_light_explores_towards_the_planned_goal_while_no_sample_shows_a_li
     assert (out["move"] == MovCmd.TURN_RIGHT) == steers_to_goal
 
 
+def test_seek_light_darkness_holds_through_noise_ends_at_a_brighter_sample_and_not_at_a_bright_plateau():
+    """seed 3.2.16: a shaded room reads the ambient light give or take 2 LSC steps; that is dark (explore the
+    map) for as long as it lasts, not a gradient to climb. A sample 8 steps brighter (the lamp seen past the
+    wall's end) ends it; readings flat at the lamp (the LSC saturated) are not dark: the light is here."""
+    t = Tuning()
+    task = TaskModule("seek_light", t)
+    assert t.light_flat_log > 2 * LSC_STEP_LOG
+    noise = [0, 2, 1, 0, 2, 1, 0, 2, 1, 2, 0, 1, 2, 0, 2, 1]
+    seq = 0
+
+    def sample(log_lux: float) -> None:
+        nonlocal seq
+        seq += 1
+        x, y = 0.3 * (seq % 4), 0.3 * (seq // 4 % 4)          # spread in both directions: a fit is possible
+        task.step({"light": (seq, x, y, log_lux), "pose": (x, y, 0.0)}, 2.5 * seq)
+
+    for k, n in enumerate(noise):
+        sample(0.7 + n * LSC_STEP_LOG)
+        assert task.dark() == (k + 1 >= t.light_samples)       # dark from the first full set on, and it holds
+    assert task.gradient is None                               # no gradient fitted to the noise
+    sample(0.7 + 8 * LSC_STEP_LOG)
+    assert not task.dark()
+    for _k in range(2 * t.light_samples):                      # at the lamp: flat, but far above the ambient
+        sample(3.0)
+        assert not task.dark()
+
+
 def test_seek_light_walks_round_an_obstacle_on_one_side():
     t = Tuning()
     task = TaskModule("seek_light", t)
@@ -256,6 +284,26 @@ def test_seek_light_walks_round_an_obstacle_on_one_side():
     assert math.copysign(1.0, h2) == side
     # nothing in the way: straight for the target
     assert task._detour({"echoes": ()}, (0.0, 0.0, 0.0), 0.3, 20.0) == 0.3
+
+
+def test_a_detour_keeps_clear_of_the_mapped_obstacle_the_echo_memory_has_let_go():
+    t = Tuning()
+    wall = tuple((0.4, -0.6 + 0.05 * k, 0.0, 0.0) for k in range(25))     # the same wall, now only on the map
+    task = TaskModule("seek_light", t)
+    assert task._detour({"echoes": (), "mapped": ()}, (0.0, 0.0, 0.0), 0.0, 0.0) == 0.0
+    h = task._detour({"echoes": (), "mapped": wall}, (0.0, 0.0, 0.0), 0.0, 0.0)
+    assert abs(math.degrees(h)) >= 40
+    assert clear_ahead(body_frame(wall, (0.0, 0.0, h)), t.avoid_half_width_m) >= t.light_clear_m
+
+
+def test_the_node_senses_the_mapped_obstacles_round_it(spec):
+    metres = quantizer(M.XmitDataUsrc, "distance")
+    rig = np3(spec, task="seek_light")
+    for k in range(0, 360, 5):                                               # walls 0.8 m all round
+        rig.inject(0.1 + k / 400, MCP, data("USRC", metres.raw(0.8), VALUE, channel=k))
+    rig.run(2.0)
+    mapped = rig.node.layers.sensors["mapped"]
+    assert mapped and all(0.6 < math.hypot(mx, my) <= T.NP3_MAPPED_NEAR_M for mx, my, _s, _a in mapped)
 
 
 def test_dead_reckoning_counts_sidesteps():
