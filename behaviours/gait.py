@@ -157,6 +157,9 @@ class Gait:
             return
         if cmd not in MOTION or cmd == self.command:
             return
+        if self._reversal(cmd):
+            self._reverse(cmd)
+            return
         self.command = cmd
         # react now (seed 5.2): stance feet carry on in the new direction from where they are,
         # swinging feet re-aim their touchdown; the phase is re-fitted once every foot is down
@@ -172,6 +175,39 @@ class Gait:
             else:
                 pl.c = self._project(leg, pl.pos) if cmd != STOP else 0.0
         self.pending = True
+
+    def _reversal(self, cmd: int) -> bool:
+        """The new direction is the old one backwards, and the pattern is in step (not awaiting a re-phase)."""
+        if self.pending or STOP in (cmd, self.command):
+            return False
+        return all(a == -b for a, b in zip(MOTION[cmd], MOTION[self.command]))
+
+    def _reverse(self, cmd: int) -> None:
+        """Walk the pattern backwards in place (seed 3.2.3: no foot jumps; seed 5.2: react now).
+
+        Backwards, the stroke coordinates flip (c -> -c: the foot that just landed is now at the rear)
+        and so does the order of lift-offs: with the offsets negated and the phase phi -> duty - phi,
+        every leg's place in its cycle is mirrored (u -> duty - u), which is exactly where its foot
+        is. No foot waits for the others to land, so a reversal costs the same whatever the phase.
+        """
+        self.command = cmd
+        self.offset = {leg: -o % 1.0 for leg, o in self.offset.items()}
+        phi = (self.duty - self.phase) % 1.0
+        self.phase = math.floor(self.phase) + 1.0 + phi
+        for leg in self.legs:
+            pl = self.plans[leg]
+            u = (phi - self.offset[leg]) % 1.0
+            if pl.swing:                               # flies back to where it lifted off in what its swing has taken so far
+                x, y, z = self.target(leg)
+                left = max((1.0 - u) * self.cycle if u >= self.duty else 0.0, self.dt)
+                if left < T.GAIT_MIN_SWING * self.t_swing:    # barely lifted: straight back down, no higher
+                    pl.lift = z
+                pl.pos, pl.z0, pl.t0, pl.dur = (x, y), z, self.t, left
+                pl.end, pl.cmd = self.path(leg, 0.5), cmd
+                pl.next_lift = self.phase + left / self.cycle + self.duty
+            else:
+                pl.c = -pl.c
+                pl.next_lift = self.phase + (self.duty - u if u < self.duty else 0.0)
 
     def drop_leg(self, leg: int) -> None:
         """A leg is lost (seed 6.3: five of six suffice): walk the five-legged wave from the next all-feet-down."""
