@@ -43,6 +43,12 @@ MOTION = {
     SIDESTEP_RIGHT: (0.0, -1.0, 0.0), SIDESTEP_LEFT: (0.0, 1.0, 0.0),
 }
 
+def _straight(cmd: int) -> bool:
+    """A direction that moves the body along a straight line (not STOP, not a turn)."""
+    vx, vy, w = MOTION[cmd]
+    return w == 0.0 and (vx, vy) != (0.0, 0.0)
+
+
 WAVE_ORDER = (3, 2, 1, 6, 5, 4)      # CHOICE: metachronal, rear to front, left side then right side
 
 
@@ -160,7 +166,7 @@ class Gait:
         if self._reversal(cmd):
             self._reverse(cmd)
             return
-        self.command = cmd
+        was, self.command = self.command, cmd
         # react now (seed 5.2): stance feet carry on in the new direction from where they are,
         # swinging feet re-aim their touchdown; the phase is re-fitted once every foot is down
         for leg in self.legs:
@@ -174,7 +180,11 @@ class Gait:
                     pl.cmd = cmd
             else:
                 pl.c = self._project(leg, pl.pos) if cmd != STOP else 0.0
-        self.pending = True
+        # from one straight line to another the feet keep their rhythm: each stance foot projects near the
+        # middle of its new stroke, so none waits more than a start does, whereas waiting for every foot to
+        # land would let all of them drift to their rear limits together (a pause that depends on the phase).
+        # A start, a stop or a turn (the feet scatter along their new arcs) re-phases once every foot is down.
+        self.pending = self.pending or not (_straight(cmd) and _straight(was))
 
     def _reversal(self, cmd: int) -> bool:
         """The new direction is the old one backwards, and the pattern is in step (not awaiting a re-phase)."""
