@@ -201,15 +201,14 @@ class Gait:
         is. No foot waits for the others to land, so a reversal costs the same whatever the phase.
         """
         self.command = cmd
+        stance_so_far = {leg: min((self.phase - o) % 1.0, self.duty) for leg, o in self.offset.items()}   # late: a whole stance
         self.offset = {leg: -o % 1.0 for leg, o in self.offset.items()}
-        phi = (self.duty - self.phase) % 1.0
-        self.phase = math.floor(self.phase) + 1.0 + phi
+        self.phase = math.floor(self.phase) + 1.0 + (self.duty - self.phase) % 1.0
         for leg in self.legs:
             pl = self.plans[leg]
-            u = (phi - self.offset[leg]) % 1.0
             if pl.swing:                               # flies back to where it lifted off in what its swing has taken so far
                 x, y, z = self.target(leg)
-                left = max((1.0 - u) * self.cycle if u >= self.duty else 0.0, self.dt)
+                left = max(self.t - pl.t0, self.dt)    # its own clock: the phase may call it landed a tick early
                 if left < T.GAIT_MIN_SWING * self.t_swing:    # barely lifted: straight back down, no higher
                     pl.lift = z
                 pl.pos, pl.z0, pl.t0, pl.dur = (x, y), z, self.t, left
@@ -217,7 +216,7 @@ class Gait:
                 pl.next_lift = self.phase + left / self.cycle + self.duty
             else:
                 pl.c = -pl.c
-                pl.next_lift = self.phase + (self.duty - u if u < self.duty else 0.0)
+                pl.next_lift = self.phase + stance_so_far[leg]     # back to its new rear end in what its stance took
 
     def drop_leg(self, leg: int) -> None:
         """A leg is lost (seed 6.3: five of six suffice): walk the five-legged wave from the next all-feet-down."""
