@@ -180,11 +180,22 @@ class Gait:
                     pl.cmd = cmd
             else:
                 pl.c = self._project(leg, pl.pos) if cmd != STOP else 0.0
-        # from one straight line to another the feet keep their rhythm: each stance foot projects near the
-        # middle of its new stroke, so none waits more than a start does, whereas waiting for every foot to
-        # land would let all of them drift to their rear limits together (a pause that depends on the phase).
-        # A start, a stop or a turn (the feet scatter along their new arcs) re-phases once every foot is down.
-        self.pending = self.pending or not (_straight(cmd) and _straight(was))
+        self.pending = self.pending or not self._keeps_rhythm(cmd, was)
+
+    def _keeps_rhythm(self, cmd: int, was: int) -> bool:
+        """Walk on in the running pattern (no wait for every foot down) after a change from `was` to `cmd`.
+
+        From one straight line to another each stance foot projects to about the middle of its new
+        stroke, so keeping the rhythm lets a foot overrun at most 1/2 - GAIT_OVERRUN strokes (one due a
+        whole stroke later). Waiting for the swinging feet to land instead lets every stance foot drift
+        t_swing / t_stance strokes towards its rear limit at once, and the pause then depends on where in
+        the cycle the command came (issue 17): the rhythm is kept where that drift is the larger (tripod,
+        ripple; the wave lifts one foot at a time and waits). A start, a stop or a turn (the feet scatter
+        along their new arcs) re-phases once every foot is down.
+        """
+        if not (_straight(cmd) and _straight(was)):
+            return False
+        return self.t_swing / self.t_stance > 0.5 - T.GAIT_OVERRUN
 
     def _reversal(self, cmd: int) -> bool:
         """The new direction is the old one backwards, and the pattern is in step (not awaiting a re-phase)."""
