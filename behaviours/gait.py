@@ -12,7 +12,11 @@ Changing the gait or the direction (seed 3.2.3: a gait change keeps the
 direction) never makes a foot jump: stance feet carry on from where they
 are in the new direction at once, swinging feet re-aim their touchdown,
 no new swing starts until every foot is down, and then the new gait's
-phase is chosen to fit where the feet are (`_rephase`). With a leg lost
+phase is chosen to fit where the feet are (`_rephase`). Two direction
+changes skip that wait, whose cost would depend on the phase the command
+lands at: a reversal walks the pattern backwards in place (`_reverse`), and
+in the tripod and ripple a change between straight lines keeps the rhythm
+(`_keeps_rhythm`). With a leg lost
 (seed 6.3 allows one) the remaining five walk a wave over five legs with a
 shorter stroke, the two feet on the lost leg's side spread to straddle it,
 so that four feet on the ground always keep the body statically stable.
