@@ -14,9 +14,9 @@ are in the new direction at once, swinging feet re-aim their touchdown,
 no new swing starts until every foot is down, and then the new gait's
 phase is chosen to fit where the feet are (`_rephase`). Two direction
 changes skip that wait, whose cost would depend on the phase the command
-lands at: a reversal walks the pattern backwards in place (`_reverse`), and
-in the tripod and ripple a change between straight lines keeps the rhythm
-(`_keeps_rhythm`). With a leg lost
+lands at: in the tripod and ripple a reversal walks the pattern backwards
+in place (`_reverse`) and a change between straight lines keeps the rhythm
+(`_keeps_rhythm`); the wave lifts one foot at a time, and waits as before. With a leg lost
 (seed 6.3 allows one) the remaining five walk a wave over five legs with a
 shorter stroke, the two feet on the lost leg's side spread to straddle it,
 so that four feet on the ground always keep the body statically stable.
@@ -197,13 +197,16 @@ class Gait:
         ripple; the wave lifts one foot at a time and waits). A start, a stop or a turn (the feet scatter
         along their new arcs) re-phases once every foot is down.
         """
-        if not (_straight(cmd) and _straight(was)):
-            return False
+        return _straight(cmd) and _straight(was) and self._waiting_drifts_far()
+
+    def _waiting_drifts_far(self) -> bool:
+        """Waiting for the swinging feet to land drifts the stance feet further than keeping the rhythm overruns."""
         return self.t_swing / self.t_stance > 0.5 - T.GAIT_OVERRUN
 
     def _reversal(self, cmd: int) -> bool:
-        """The new direction is the old one backwards, and the pattern is in step (not awaiting a re-phase)."""
-        if self.pending or STOP in (cmd, self.command):
+        """The new direction is the old one backwards, the pattern is in step (not awaiting a re-phase), and
+        waiting would cost more than a start (tripod, ripple; the wave's one foot up lands soon enough)."""
+        if self.pending or STOP in (cmd, self.command) or not self._waiting_drifts_far():
             return False
         return all(a == -b for a, b in zip(MOTION[cmd], MOTION[self.command]))
 
