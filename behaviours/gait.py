@@ -14,9 +14,9 @@ are in the new direction at once, swinging feet re-aim their touchdown,
 no new swing starts until every foot is down, and then the new gait's
 phase is chosen to fit where the feet are (`_rephase`). Two direction
 changes skip that wait, whose cost would depend on the phase the command
-lands at: in the tripod and ripple a reversal walks the pattern backwards
-in place (`_reverse`) and a change between straight lines keeps the rhythm
-(`_keeps_rhythm`); the wave lifts one foot at a time, and waits as before. With a leg lost
+lands at: a reversal walks the pattern backwards in place (`_reverse`; the
+next re-phase turns it the right way round again), and in the tripod and
+ripple a change between straight lines keeps the rhythm (`_keeps_rhythm`). With a leg lost
 (seed 6.3 allows one) the remaining five walk a wave over five legs with a
 shorter stroke, the two feet on the lost leg's side spread to straddle it,
 so that four feet on the ground always keep the body statically stable.
@@ -204,9 +204,8 @@ class Gait:
         return self.t_swing / self.t_stance > 0.5 - T.GAIT_OVERRUN
 
     def _reversal(self, cmd: int) -> bool:
-        """The new direction is the old one backwards, the pattern is in step (not awaiting a re-phase), and
-        waiting would cost more than a start (tripod, ripple; the wave's one foot up lands soon enough)."""
-        if self.pending or STOP in (cmd, self.command) or not self._waiting_drifts_far():
+        """The new direction is the old one backwards, and the pattern is in step (not awaiting a re-phase)."""
+        if self.pending or STOP in (cmd, self.command):
             return False
         return all(a == -b for a, b in zip(MOTION[cmd], MOTION[self.command]))
 
@@ -302,6 +301,7 @@ class Gait:
 
     def _rephase(self) -> None:
         """Choose the new pattern's phase that fits where the stance feet are (no foot overruns its stroke)."""
+        self.offset = pattern(self.running, self.legs)[1]      # the right way round again after a reversal
         best, best_phi = math.inf, 0.0
         for i in range(T.GAIT_REPHASE_STEPS):
             phi = i / T.GAIT_REPHASE_STEPS
