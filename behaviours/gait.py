@@ -16,8 +16,8 @@ phase is chosen to fit where the feet are (`_rephase`). Two direction
 changes skip that wait, whose cost would depend on the phase the command
 lands at: a reversal walks the pattern backwards in place (`_reverse`; the
 next re-phase turns it the right way round again), and in the tripod and
-ripple a change between straight lines keeps the rhythm (`_keeps_rhythm`). With a leg lost
-(seed 6.3 allows one) the remaining five walk a wave over five legs with a
+ripple a change between straight lines keeps the rhythm (`_keeps_rhythm`).
+With a leg lost (seed 6.3 allows one) the remaining five walk a wave over five legs with a
 shorter stroke, the two feet on the lost leg's side spread to straddle it,
 so that four feet on the ground always keep the body statically stable.
 """
@@ -46,6 +46,7 @@ MOTION = {
     TURN_RIGHT: (0.0, 0.0, -1.0), TURN_LEFT: (0.0, 0.0, 1.0),
     SIDESTEP_RIGHT: (0.0, -1.0, 0.0), SIDESTEP_LEFT: (0.0, 1.0, 0.0),
 }
+
 
 def _straight(cmd: int) -> bool:
     """A direction that moves the body along a straight line (not STOP, not a turn)."""
@@ -172,7 +173,8 @@ class Gait:
             return
         was, self.command = self.command, cmd
         # react now (seed 5.2): stance feet carry on in the new direction from where they are,
-        # swinging feet re-aim their touchdown; the phase is re-fitted once every foot is down
+        # swinging feet re-aim their touchdown; the phase is re-fitted once every foot is down,
+        # unless the pattern can walk on in its rhythm
         for leg in self.legs:
             pl = self.plans[leg]
             if pl.swing:
