@@ -159,6 +159,10 @@ class NP3(Runtime, Np3Skeleton):
         if not self.running:
             self.running = True
             self.look_until = self.now + T.NP3_START_LOOK_S
+            # seed 6.3: after POST the legs stand (the MMC holds them), so a task that wants STOP has nothing
+            # to say; sending it anyway overrode an operator's MOVE typed right after POST (3.2.8: the RCP's commands)
+            if self.sent is None:
+                self.sent = (_STOP, "task")
             self.hw.note("nav_start")          # 5.2: from here on the robot can act on what it senses
             self.tick()
 
