@@ -53,12 +53,16 @@ def _shown(value: Any) -> str:
 
 
 def _problem(err: jsonschema.ValidationError) -> tuple[list[Any], str]:
-    """(path to point at, message) for one schema violation."""
+    """(path to point at, message) for one schema violation: the one wording of the spec's lint, the scenarios and
+    the sweeps. A schema's `description` of a value names what was expected when its type or pattern does not fit."""
     path = list(err.absolute_path)
-    custom = (err.schema.get("x-messages") or {}).get(err.validator) if isinstance(err.schema, dict) else None
+    schema = err.schema if isinstance(err.schema, dict) else {}
+    custom = (schema.get("x-messages") or {}).get(err.validator)
     if custom:
         return path, custom
     v, inst = err.validator_value, err.instance
+    if err.validator in ("type", "pattern") and "description" in schema:
+        return path, f"expected {schema['description']}, got {_shown(inst)}"
     if err.validator == "type":
         kinds = v if isinstance(v, list) else [v]
         return path, f"expected {' or '.join(_TYPE_WORDS.get(k, k) for k in kinds)}, got {_shown(inst)}"
@@ -67,9 +71,9 @@ def _problem(err: jsonschema.ValidationError) -> tuple[list[Any], str]:
     limits = {"minimum": ">=", "exclusiveMinimum": ">", "maximum": "<=", "exclusiveMaximum": "<"}
     if err.validator in limits:
         return path, f"must be {limits[err.validator]} {v}, got {inst}"
-    if err.validator == "required":
-        missing = next(k for k in v if k not in inst)
-        return path, f"missing required key {missing!r}"
+    if err.validator == "required":         # jsonschema reports each missing key alone: name them all, once
+        missing = [k for k in v if k not in inst]
+        return path, f"missing required key{'s' if len(missing) > 1 else ''} {', '.join(map(repr, missing))}"
     if err.validator == "additionalProperties":
         known = list(err.schema.get("properties", {}))
         extra = next(k for k in inst if k not in known)
@@ -83,14 +87,15 @@ def _problem(err: jsonschema.ValidationError) -> tuple[list[Any], str]:
 
 
 def schema_errors(doc: Any, schema: dict[str, Any]) -> Iterator[UserError]:
-    """Every violation as a one-line UserError, in document order."""
-    errors = []
+    """One one-line UserError (`file:line: field: problem`) per field that breaks the schema, its first problem,
+    in document order."""
+    errors: dict[str, tuple[str, int, UserError]] = {}
     for err in Validator(schema).iter_errors(doc):
         path, message = _problem(err)
         what = field_name(path) or "(top level)"
         file, line = where(doc, path)
-        errors.append((file, line or 0, locate(doc, path, f"{what}: {message}")))
-    for _f, _l, exc in sorted(errors, key=lambda e: (e[0], e[1])):
+        errors.setdefault(what, (file, line or 0, locate(doc, path, f"{what}: {message}")))
+    for _f, _l, exc in sorted(errors.values(), key=lambda e: (e[0], e[1])):
         yield exc
 
 

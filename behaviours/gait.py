@@ -12,8 +12,12 @@ Changing the gait or the direction (seed 3.2.3: a gait change keeps the
 direction) never makes a foot jump: stance feet carry on from where they
 are in the new direction at once, swinging feet re-aim their touchdown,
 no new swing starts until every foot is down, and then the new gait's
-phase is chosen to fit where the feet are (`_rephase`). With a leg lost
-(seed 6.3 allows one) the remaining five walk a wave over five legs with a
+phase is chosen to fit where the feet are (`_rephase`). Two direction
+changes skip that wait, whose cost would depend on the phase the command
+lands at: a reversal walks the pattern backwards in place (`_reverse`; the
+next re-phase turns it the right way round again), and in the tripod and
+ripple a change between straight lines keeps the rhythm (`_keeps_rhythm`).
+With a leg lost (seed 6.3 allows one) the remaining five walk a wave over five legs with a
 shorter stroke, the two feet on the lost leg's side spread to straddle it,
 so that four feet on the ground always keep the body statically stable.
 """
@@ -42,6 +46,13 @@ MOTION = {
     TURN_RIGHT: (0.0, 0.0, -1.0), TURN_LEFT: (0.0, 0.0, 1.0),
     SIDESTEP_RIGHT: (0.0, -1.0, 0.0), SIDESTEP_LEFT: (0.0, 1.0, 0.0),
 }
+
+
+def _straight(cmd: int) -> bool:
+    """A direction that moves the body along a straight line (not STOP, not a turn)."""
+    vx, vy, w = MOTION[cmd]
+    return w == 0.0 and (vx, vy) != (0.0, 0.0)
+
 
 WAVE_ORDER = (3, 2, 1, 6, 5, 4)      # CHOICE: metachronal, rear to front, left side then right side
 
@@ -157,9 +168,13 @@ class Gait:
             return
         if cmd not in MOTION or cmd == self.command:
             return
-        self.command = cmd
+        if self._reversal(cmd):
+            self._reverse(cmd)
+            return
+        was, self.command = self.command, cmd
         # react now (seed 5.2): stance feet carry on in the new direction from where they are,
-        # swinging feet re-aim their touchdown; the phase is re-fitted once every foot is down
+        # swinging feet re-aim their touchdown; the phase is re-fitted once every foot is down,
+        # unless the pattern can walk on in its rhythm
         for leg in self.legs:
             pl = self.plans[leg]
             if pl.swing:
@@ -171,7 +186,56 @@ class Gait:
                     pl.cmd = cmd
             else:
                 pl.c = self._project(leg, pl.pos) if cmd != STOP else 0.0
-        self.pending = True
+        self.pending = self.pending or not self._keeps_rhythm(cmd, was)
+
+    def _keeps_rhythm(self, cmd: int, was: int) -> bool:
+        """Walk on in the running pattern (no wait for every foot down) after a change from `was` to `cmd`.
+
+        From one straight line to another each stance foot projects to about the middle of its new
+        stroke, so keeping the rhythm lets a foot overrun at most 1/2 - GAIT_OVERRUN strokes (one due a
+        whole stroke later). Waiting for the swinging feet to land instead lets every stance foot drift
+        t_swing / t_stance strokes towards its rear limit at once, and the pause then depends on where in
+        the cycle the command came (issue 17): the rhythm is kept where that drift is the larger (tripod,
+        ripple; the wave lifts one foot at a time and waits). A start, a stop or a turn (the feet scatter
+        along their new arcs) re-phases once every foot is down.
+        """
+        return _straight(cmd) and _straight(was) and self._waiting_drifts_far()
+
+    def _waiting_drifts_far(self) -> bool:
+        """Waiting for the swinging feet to land drifts the stance feet further than keeping the rhythm overruns."""
+        return self.t_swing / self.t_stance > 0.5 - T.GAIT_OVERRUN
+
+    def _reversal(self, cmd: int) -> bool:
+        """The new direction is the old one backwards, and the pattern is in step (not awaiting a re-phase)."""
+        if self.pending or STOP in (cmd, self.command):
+            return False
+        return all(a == -b for a, b in zip(MOTION[cmd], MOTION[self.command]))
+
+    def _reverse(self, cmd: int) -> None:
+        """Walk the pattern backwards in place (seed 3.2.3: no foot jumps; seed 5.2: react now).
+
+        Backwards, the stroke coordinates flip (c -> -c: the foot that just landed is now at the rear)
+        and so does the order of lift-offs: with the offsets negated and the phase phi -> duty - phi,
+        every leg's place in its cycle is mirrored (u -> duty - u), which is exactly where its foot
+        is. No foot waits for the others to land, so a reversal costs the same whatever the phase.
+        """
+        self.command = cmd
+        stance_so_far = {leg: min((self.phase - o) % 1.0, self.duty) for leg, o in self.offset.items()}   # late: a whole stance
+        self.offset = {leg: -o % 1.0 for leg, o in self.offset.items()}
+        self.phase = math.floor(self.phase) + 1.0 + (self.duty - self.phase) % 1.0
+        for leg in self.legs:
+            pl = self.plans[leg]
+            if pl.swing:                               # flies back to where it lifted off in what its swing has taken so far
+                x, y, z = self.target(leg)
+                left = max(self.t - pl.t0, self.dt)    # its own clock: the phase may call it landed a tick early
+                if left < T.GAIT_MIN_SWING * self.t_swing:    # barely lifted: straight back down, no higher
+                    pl.lift = z
+                pl.pos, pl.z0, pl.t0, pl.dur = (x, y), z, self.t, left
+                pl.end, pl.cmd = self.path(leg, 0.5), cmd
+                pl.next_lift = self.phase + left / self.cycle + self.duty
+            else:
+                pl.c = -pl.c
+                pl.next_lift = self.phase + stance_so_far[leg]     # back to its new rear end in what its stance took
 
     def drop_leg(self, leg: int) -> None:
         """A leg is lost (seed 6.3: five of six suffice): walk the five-legged wave from the next all-feet-down."""
@@ -239,6 +303,7 @@ class Gait:
 
     def _rephase(self) -> None:
         """Choose the new pattern's phase that fits where the stance feet are (no foot overruns its stroke)."""
+        self.offset = pattern(self.running, self.legs)[1]      # the right way round again after a reversal
         best, best_phi = math.inf, 0.0
         for i in range(T.GAIT_REPHASE_STEPS):
             phi = i / T.GAIT_REPHASE_STEPS

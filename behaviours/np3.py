@@ -32,8 +32,8 @@ from behaviours import tuning as T
 from behaviours.np3_layers import (AVOIDANCE, REFLEXES, Tuning, body_frame, closing_in, np3_network, safe_instead,
                                    steepness_deg, uphill)
 from behaviours.runtime import Runtime
-from behaviours.topomap import OCCUPIED, OccupancyGrid, Reading, TopoMap, ray_cells
-from behaviours.units import RECORD_AGE, XMIT_DATA_OF, Quantizer, from_record_byte, quantizer
+from behaviours.topomap import OCCUPIED, FrontierTarget, OccupancyGrid, Reading, TopoMap, ray_cells
+from behaviours.units import RECORD_AGE, RECORD_QUANTIZER, Quantizer, from_record_byte
 
 _VALUE, _ALARM, _STATUS = int(RecordKind.VALUE), int(RecordKind.ALARM), int(RecordKind.STATUS)
 _IR_BAD = {int(RangeStatus.UNRELIABLE), int(RangeStatus.OUT_OF_ORDER)}
@@ -41,9 +41,8 @@ _NO_GROUND, _BLOCKED = int(MmcError.NO_GROUND), int(MmcError.LEG_DRIVE_BLOCKED)
 _STOP, _FORWARD, _BACKWARD = int(MovCmd.STOP), int(MovCmd.FORWARD), int(MovCmd.BACKWARD)
 _LEFT, _RIGHT = int(MovCmd.TURN_LEFT), int(MovCmd.TURN_RIGHT)
 _SIDE_L, _SIDE_R = int(MovCmd.SIDESTEP_LEFT), int(MovCmd.SIDESTEP_RIGHT)
-# the field of each source role's XMIT_DATA layout whose encoding its records carry (spec messages)
-_FIELD = {"IRRC": "center", "ISC": "longitudinal", "LSC": "brightness", "PSC": "voltage", "USRC": "distance"}
-_Q: dict[str, Quantizer] = {role: quantizer(XMIT_DATA_OF[role], f) for role, f in _FIELD.items()}
+# the encoding each source role's records carry (spec messages.<m>.record_values)
+_Q: dict[str, Quantizer] = RECORD_QUANTIZER
 
 
 def decode(role: str, value: int) -> float:
@@ -194,6 +193,8 @@ class NP3(Runtime, Np3Skeleton):
         self.takeovers: dict[str, int] = {}
         # registers and what the records told so far
         self.ir: list[float | None] = [None, None, None]
+        self.heard: set[str] = set()          # roles that sent a record since power-on
+        self.look_until = math.inf            # no step before the IR and whiskers reported, or until then (seed 5.2)
         self.tilt = [0.0, 0.0]
         self.seq = {"whisker": 0, "pit": 0, "leg_blocked": 0, "light": 0, "sound": 0, "veto": 0}
         self.escape_plans: dict[str, Any] = {}   # module -> its manoeuvre last noted as an escape window (5.2)
@@ -205,8 +206,10 @@ class NP3(Runtime, Np3Skeleton):
         self.records = 0
         self.lux: list[float] = []
         self.next_plan = 0.0
+        self.planned_at = -math.inf           # the last full plan (a rebuilt map): at most one per NP3_PLAN_CHANGED_S
         self.goal: tuple[float, float] | None = None
         self.routes_planned = 0               # routes planned over the topological map (3.3.2)
+        self.frontier_target = FrontierTarget(T.NP3_PLAN_EXCLUDE_M, T.NP3_PLAN_PROGRESS_M, T.NP3_PLAN_PATIENCE_S)
         self.visited: set[tuple[int, int]] = set()
         self.last_cell: tuple[int, int] | None = None
         self.every(T.NP3_PERIOD_S, self.tick)
@@ -215,6 +218,11 @@ class NP3(Runtime, Np3Skeleton):
         """seed 3.2.3: INIT from the MCP after POST starts navigation with a zeroed world model."""
         if not self.running:
             self.running = True
+            self.look_until = self.now + T.NP3_START_LOOK_S
+            # seed 6.3: after POST the legs stand (the MMC holds them), so a task that wants STOP has nothing
+            # to say; sending it anyway overrode an operator's MOVE typed right after POST (3.2.8: the RCP's commands)
+            if self.sent is None:
+                self.sent = (_STOP, "task")
             self.hw.note("nav_start")          # 5.2: from here on the robot can act on what it senses
             self.tick()
 
@@ -233,12 +241,18 @@ class NP3(Runtime, Np3Skeleton):
             self.echoes.popleft()
         self.layers.sense(pose=(x, y, th), sonar_ahead_m=ahead[1] if fresh else None,
                           echoes=tuple(e.point() for e in self.echoes))
+        if self.cfg.task in ("explore", "seek_light", "avoid_light"):   # the tasks that detour (TaskModule._detour)
+            g = self.map.grid
+            self.layers.sense(mapped=tuple((mx, my, 0.0, g.res / 2)
+                                           for mx, my in g.occupied_near(x, y, T.NP3_MAPPED_NEAR_M)))
         if self.cfg.task in ("explore", "seek_light"):     # seeking light explores while it is dark
             self.mark_visited(x, y)
             goal = self.goal
             if now >= self.next_plan or (goal is not None and math.hypot(goal[0] - x, goal[1] - y)
                                          < T.NP3_GOAL_REACHED_M):
                 self.plan_goal(now)
+        if not self.heard.issuperset(T.SPU_FIRST_POLL) and now < self.look_until:
+            return       # seed 5.2: switched on next to a wall, the first step waits for what IR and whiskers sense
         cmd = self.layers.step()["move"]
         if cmd is not None and self.refused(int(cmd), (x, y, th)):
             cmd = self.layers.step()["move"]          # the guard reflex now holds the actuator
@@ -291,11 +305,14 @@ class NP3(Runtime, Np3Skeleton):
                 self.goal = route[0]
                 self.layers.sense(goal=self.goal)
                 return
+        if now < self.planned_at + T.NP3_PLAN_CHANGED_S:
+            return                                 # a goal reached at once (a short ray): not a rebuild every tick
+        self.planned_at = now
         self.next_plan = now + T.NP3_EXPLORE_PLAN_S
         self.map.plan = []
         if self.cfg.task == "seek_light":          # searching for a light it cannot see: the nearest unknown
             # the widest opening onto the unknown first, round walls by the map (a lamp behind a wall)
-            self.goal = self.route_to_frontier(x, y, T.NP3_SEEK_FRONTIER_WEIGHT_M)
+            self.goal = self.route_to_frontier(x, y, now, T.NP3_SEEK_FRONTIER_WEIGHT_M)
             if self.goal is not None:
                 self.layers.sense(goal=self.goal)
                 return
@@ -317,23 +334,27 @@ class NP3(Runtime, Np3Skeleton):
             length = min(best[2] - T.NP3_EXPLORE_MARGIN_M, T.NP3_EXPLORE_GOAL_M)
             self.goal = (x + length * math.cos(best[1]), y + length * math.sin(best[1]))
         else:
-            self.goal = self.route_to_frontier(x, y)
+            self.goal = self.route_to_frontier(x, y, now)
         self.layers.sense(goal=self.goal)
 
-    def route_to_frontier(self, x: float, y: float, size_weight: float = 0.0) -> tuple[float, float] | None:
-        """seed 3.3.2: plan over the rebuilt topological map to the nearest frontier (`size_weight`: m of path a
-        cell of frontier is worth, TopoMap.frontier); its first waypoint."""
+    def route_to_frontier(self, x: float, y: float, now: float, size_weight: float = 0.0) \
+            -> tuple[float, float] | None:
+        """seed 3.3.2: a route over the rebuilt topological map to the frontier kept as the target
+        (FrontierTarget: the nearest, a cell of it worth `size_weight` m of path, until explored, refuted or
+        not approached); its first waypoint."""
         self.map.rebuild()
-        frontier = self.map.frontier(x, y, min_size=T.NP3_PLAN_MIN_FRONTIER, min_path_m=T.NP3_PLAN_MIN_PATH_M,
-                                     size_weight=size_weight)
-        route = self.map.route((x, y), (frontier.x, frontier.y)) if frontier is not None else None
-        while route and math.dist(route[0], (x, y)) < T.NP3_GOAL_REACHED_M:
-            route.pop(0)
-        self.map.plan = route or []
-        if not route:
+        self.map.plan = self.frontier_target.route(self.map, x, y, now, T.NP3_GOAL_REACHED_M,
+                                                   min_size=T.NP3_PLAN_MIN_FRONTIER,
+                                                   min_path_m=T.NP3_PLAN_MIN_PATH_M, size_weight=size_weight)
+        if not self.map.plan:
             return None
         self.routes_planned += 1
-        return route[0]
+        return self.map.plan[0]
+
+    def map_changed(self) -> None:
+        """seed 3.3.2: a barrier joined the map: plan again within NP3_PLAN_CHANGED_S (not at every record of a
+        slope the body stands on: one rebuild per that time at most)."""
+        self.next_plan = min(self.next_plan, self.now + T.NP3_PLAN_CHANGED_S)
 
     def mark_visited(self, x: float, y: float) -> None:
         """The map cells within NP3_EXPLORE_SEEN_M of the dead-reckoned path (what exploring has covered)."""
@@ -380,6 +401,7 @@ class NP3(Runtime, Np3Skeleton):
         self.records += 1
         role, kind, ch, v = NODES[msg.address].role, msg.kind, msg.channel, msg.value
         measured_at = self.now - RECORD_AGE.phys(msg.age)          # issue 17: when the source measured it
+        self.heard.add(role)
         urgent = True
         if role == "MMC" and kind == _STATUS:
             self.mmc_status(ch, v)
@@ -441,6 +463,7 @@ class NP3(Runtime, Np3Skeleton):
                 fx, fy = self.geo.neutral_foot(leg) if leg in self.geo.legs else (self.geo.hip_x[0], 0.0)
                 self.echo(fx, fy, 0.0, 0.0)          # the edge joins the local memory (the motion check) ...
                 self.map.grid.mark_barrier(*self.at_body(fx, fy))   # ... and the map: the pit is part of it (3.3.2)
+                self.map_changed()
                 self.bump("pit", fx, fy)
             elif error == _BLOCKED:
                 self.bump("leg_blocked", self.geo.side(leg) if leg in self.geo.legs else 0.0)
@@ -485,6 +508,7 @@ class NP3(Runtime, Np3Skeleton):
             bx, by = ahead * ux / n, ahead * uy / n
             self.echo(bx, by, 0.0, 0.0)
             self.map.grid.mark_barrier(*self.at_body(bx, by))
+        self.map_changed()
 
     def light(self, lux: float) -> None:
         self.lux.append(lux)
@@ -565,4 +589,4 @@ class NP3(Runtime, Np3Skeleton):
         (out / "control.tsv").write_text("\n".join(rows) + "\n")
         (out / "wiring.txt").write_text(self.layers.wiring_table() + "\n")
         self.map.rebuild()
-        self.map.save_png(out / "topomap.png")
+        self.map.save_png(out / "topomap.png", given_up=self.frontier_target.given_up)

@@ -17,13 +17,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Mapping, NamedTuple
 
 from arachnae_proto.enums import MovCmd
+from arachnae_proto.messages import XmitDataLsc
 
 from behaviours import tuning as T
 from behaviours.geometry import DEFAULT_GEOMETRY
 from behaviours.subsumption import Clock, Network, Outputs, Plan, ReflexModule
+from behaviours.units import XMIT_DATA_OF, quantizer
 
 STOP, FORWARD, BACKWARD = MovCmd.STOP, MovCmd.FORWARD, MovCmd.BACKWARD
 LEFT, RIGHT = MovCmd.TURN_LEFT, MovCmd.TURN_RIGHT
@@ -45,8 +47,19 @@ Trigger = Callable[[Mapping[str, Any], float], "Steps | None"]
 #   echoes ((x, y, seen_deg, arc_m), ...) obstacle points of the last seconds (sonar, IR, whiskers) at the DR
 #                                pose, seen at body angle seen_deg, somewhere within arc_m across the beam
 #   veto (seq, command)          the node's motion check refused the command the network chose: do this instead
+#   mapped ((x, y, 0, arc_m), ...) occupied cells of the topological map round the DR pose (3.3.2): what the
+#                                echo memory has let go of (a block walked along for longer than it keeps echoes)
+_BRIGHTNESS = next(f.conv for f in XmitDataLsc.FIELDS if f.name == "brightness")
+# seed 3.2.16: one step of the LSC's logarithmic brightness code in log10 lux (1/64 decade), from the spec
+LSC_STEP_LOG = math.log10(_BRIGHTNESS.to_phys(_BRIGHTNESS.hi) / _BRIGHTNESS.to_phys(_BRIGHTNESS.lo)) \
+    / (_BRIGHTNESS.hi - _BRIGHTNESS.lo)
+
 SENSORS = ("whisker", "ir", "ir_fault", "pit", "tilt", "battery_low", "leg_blocked", "sonar_ahead_m", "light",
-           "pose", "goal", "sound", "echoes", "veto")
+           "pose", "goal", "sound", "echoes", "veto", "mapped")
+
+
+_IRRC = quantizer(XMIT_DATA_OF["IRRC"], "center")
+IR_RANGE_M = _IRRC.phys(_IRRC.hi) / 100     # spec: the IRRC's reach (cm); its top code means nothing in range
 
 
 @dataclass(frozen=True)
@@ -56,8 +69,15 @@ class Tuning:
     reflex_hold_s: float = T.NP3_REFLEX_HOLD_S
     avoid_hold_s: float = T.NP3_AVOID_HOLD_S
     contact_back_s: float = T.NP3_CONTACT_BACK_S
-    contact_turn_s: float = T.NP3_CONTACT_TURN_S
-    contact_side_turn_s: float = T.NP3_CONTACT_SIDE_TURN_S
+    contact_min_turn_deg: float = T.NP3_CONTACT_MIN_TURN_DEG
+    contact_clear_deg: float = T.NP3_CONTACT_CLEAR_DEG
+    contact_ahead_deg: float = T.NP3_CONTACT_AHEAD_DEG
+    contact_whisker_normal_deg: float = T.NP3_CONTACT_WHISKER_NORMAL_DEG
+    contact_corner_m: float = T.NP3_CONTACT_CORNER_M
+    contact_corner_normal_deg: float = T.NP3_CONTACT_CORNER_NORMAL_DEG
+    contact_near_m: float = T.NP3_CONTACT_NEAR_M
+    ir_range_m: float = IR_RANGE_M
+    ir_beam_deg: float = T.NP3_IR_BEAM_DEG
     ir_contact_m: float = T.NP3_IR_CONTACT_M
     avoid_centre_m: float = T.NP3_AVOID_CENTRE_M
     avoid_side_m: float = T.NP3_AVOID_SIDE_M
@@ -92,7 +112,7 @@ class Tuning:
     light_weave_s: float = T.NP3_LIGHT_WEAVE_S
     light_detour_step_deg: float = T.NP3_LIGHT_DETOUR_STEP_DEG
     light_detour_hold_s: float = T.NP3_LIGHT_DETOUR_HOLD_S
-    light_flat_log: float = T.NP3_LIGHT_FLAT_LOG
+    light_flat_log: float = T.NP3_LIGHT_FLAT_STEPS * LSC_STEP_LOG
     turn_rate_deg_s: float = T.NP3_DR_TURN_DEG_S   # turn on the spot (measured; nominal 20 deg per 0.8 s)
     walk_speed_m_s: float = T.NP3_DR_SPEED_M_S
     body_half_length_m: float = T.NP3_BODY_FRONT_M
@@ -121,8 +141,119 @@ class _Edge:
 
 
 # --------------------------------------------------------------------------- level 0: reflexes
+class Surface(NamedTuple):
+    """One surface the contact sensors sense, in the body frame."""
+
+    normal_rad: float      # direction from the body towards the surface (0 ahead, counter-clockwise positive)
+    dist_m: float | None   # the body centre's distance to it along that direction, None when not measured
+
+
+def ir_points(ir: Any, t: Tuning) -> list[tuple[float, float]]:
+    """Body-frame points where the IR beams (seed 3.2.13: 0 and +-ir_beam_deg, mounted at the front) see something."""
+    out = []
+    for d, deg in zip(_seen(ir), (t.ir_beam_deg, 0.0, -t.ir_beam_deg)):
+        if d is not None:
+            a = math.radians(deg)
+            out.append((t.body_half_length_m + d * math.cos(a), d * math.sin(a)))
+    return out
+
+
+def _line(pts: list[tuple[float, float]]) -> Surface:
+    """The least-squares line through body-frame points (principal axis): its normal away from the body."""
+    n = len(pts)
+    mx, my = sum(p[0] for p in pts) / n, sum(p[1] for p in pts) / n
+    sxx = sum((p[0] - mx) ** 2 for p in pts)
+    syy = sum((p[1] - my) ** 2 for p in pts)
+    sxy = sum((p[0] - mx) * (p[1] - my) for p in pts)
+    along = 0.5 * math.atan2(2 * sxy, sxx - syy)
+    nx, ny = -math.sin(along), math.cos(along)
+    dist = nx * mx + ny * my
+    if dist < 0:
+        nx, ny, dist = -nx, -ny, -dist
+    return Surface(math.atan2(ny, nx), dist)
+
+
+def sensed_surfaces(ir: Any, side: float, beside: list[Point], t: Tuning) -> list[Surface]:
+    """The surfaces touched, from the IR points: a line through two or three of them (its normal and distance),
+    two lines meeting at the centre point when it lies behind the line through the side points by more than
+    contact_corner_m, and an inside corner (walls facing the body at +-contact_corner_normal_deg from that line's
+    normal) when both side beams see something and the centre beam, which would meet that line within its
+    range, does not; one point: a surface facing the body at that point. Whiskers alone (the IR beams see
+    nothing within their 10 cm): a surface ahead (both touched, side 0) or to the touched side (+1 left, -1
+    right) facing the body at contact_whisker_normal_deg. Remembered echoes beside the body within
+    contact_near_m of it add a surface each, facing the body at that point (a wall alongside: do not turn
+    the body's corners into it)."""
+    pts = ir_points(ir, t)
+    out: list[Surface] = []
+    seen = [d is not None for d in _seen(ir)]
+    if len(pts) == 3:
+        chord = _line([pts[0], pts[2]])
+        cx, cy = pts[1]
+        behind = cx * math.cos(chord.normal_rad) + cy * math.sin(chord.normal_rad) - (chord.dist_m or 0.0)
+        out = [_line(pts[:2]), _line(pts[1:])] if behind > t.contact_corner_m else [_line(pts)]
+    elif len(pts) == 2 and seen[0] and seen[2]:
+        chord = _line(pts)
+        a = math.radians(t.contact_corner_normal_deg)
+        out = [chord]
+        if chord.dist_m is not None and math.cos(chord.normal_rad) > 0 \
+                and (chord.dist_m / math.cos(chord.normal_rad)) - t.body_half_length_m < t.ir_range_m:
+            out = [chord._replace(normal_rad=chord.normal_rad + a), chord._replace(normal_rad=chord.normal_rad - a)]
+    elif len(pts) == 2:
+        out = [_line(pts)]
+    elif pts:
+        px, py = pts[0]
+        out = [Surface(math.atan2(py, px), math.hypot(px, py))]
+    else:
+        out = [Surface(side * math.radians(t.contact_whisker_normal_deg), None)]
+    return out + [Surface(math.atan2(by, bx), math.hypot(bx, by)) for bx, by, _s, _a in beside
+                  if abs(bx) < t.body_half_length_m and body_gap(bx, by, t) < t.contact_near_m]
+
+
+def turn_clear_deg(normals_deg: list[float], clear_deg: float, prefer: float) -> float:
+    """The smallest turn on the spot (deg, counter-clockwise positive) after which every surface normal is at
+    least 90 + clear_deg from the heading (each surface behind the robot's side); `prefer` (+1 left, -1 right)
+    breaks a tie. 180 deg when no turn achieves it (surfaces all round: turn about and back out)."""
+    need = 90.0 + clear_deg
+    best: dict[float, float] = {}
+    for sign in (1.0, -1.0):
+        for k in range(0, 181):
+            if all(abs((n - sign * k + 180.0) % 360.0 - 180.0) >= need for n in normals_deg):
+                best[sign] = k
+                break
+    if not best:
+        return 180.0 * prefer
+    sign = min(best, key=lambda sg: (best[sg], sg != prefer))
+    return sign * best[sign]
+
+
+def contact_steps(surfaces: list[Surface], prefer: float, t: Tuning) -> Steps:
+    """seed 5.1.2, 5.2: step away until turning on the spot cannot sweep the body's corners into a surface (back
+    off from one ahead, never less than contact_back_s; sidestep from one alongside), then turn until every
+    sensed surface is behind the robot's side by contact_clear_deg: the robot walks on away from them, not
+    diagonally back into one."""
+    steps: Steps = []
+    sweep = math.hypot(t.body_half_length_m, t.body_half_width_m) + t.guard_margin_m
+    ahead_rad = math.radians(t.contact_ahead_deg)
+    ahead = [s for s in surfaces if abs(s.normal_rad) < ahead_rad]
+    if ahead:
+        short = max((max(0.0, sweep - s.dist_m) / math.cos(s.normal_rad) for s in ahead if s.dist_m is not None),
+                    default=0.0)
+        steps.append((max(t.contact_back_s, short / t.walk_speed_m_s), BACKWARD))
+    beside = {side: max((max(0.0, sweep - s.dist_m) / abs(math.sin(s.normal_rad)) for s in surfaces
+                         if s.dist_m is not None and abs(s.normal_rad) >= ahead_rad
+                         and math.copysign(1.0, s.normal_rad) == side), default=0.0) for side in (1.0, -1.0)}
+    if (beside[1.0] > 0.0) != (beside[-1.0] > 0.0):        # a surface alongside on one side only: step off it
+        side = 1.0 if beside[1.0] > 0.0 else -1.0
+        steps.append((beside[side] / t.side_speed_m_s, SIDE_RIGHT if side > 0 else SIDE_LEFT))
+    turn = turn_clear_deg([math.degrees(s.normal_rad) for s in surfaces], t.contact_clear_deg, prefer)
+    turn = math.copysign(max(t.contact_min_turn_deg, abs(turn)), turn if turn else prefer)
+    steps.append((abs(turn) / t.turn_rate_deg_s, LEFT if turn > 0 else RIGHT))
+    return steps
+
+
 def contact_trigger(t: Tuning) -> Trigger:
-    """seed 3.2.12, 3.2.13, 5.2: a whisker touches or an IR echo is almost at the body -> back off, turn away."""
+    """seed 3.2.12, 3.2.13, 5.2: a whisker touches or an IR echo is almost at the body -> back off, turn away
+    from the surface the IR beams (or the whisker) sense until it is behind the robot's side."""
     edge = _Edge()
 
     def trigger(i: Mapping[str, Any], now: float) -> Steps | None:
@@ -133,14 +264,14 @@ def contact_trigger(t: Tuning) -> Trigger:
         close = [d is not None and d < t.ir_contact_m for d in ir]
         if not (touched or any(close)):
             return None
-        if touched:
-            obj_left = left and not right
+        if touched and left != right:
+            obj_left = left                    # seed 3.2.12: OBJ_LEFT -> turn right
         else:                                  # the nearer side beam says where the object is
             obj_left = (ir[0] or math.inf) < (ir[-1] or math.inf)
-        away = RIGHT if obj_left else LEFT     # seed 3.2.12: OBJ_LEFT -> turn right
-        if touched and left != right and not any(close):
-            return [(t.contact_side_turn_s, away)]     # one whisker grazes: turn away, no need to back off
-        return [(t.contact_back_s, BACKWARD), (t.contact_turn_s, away)]
+        pose = i.get("pose")
+        beside = body_frame(i.get("echoes"), pose) if pose is not None else []
+        surfaces = sensed_surfaces(ir, 0.0 if left == right else (1.0 if left else -1.0), beside, t)
+        return contact_steps(surfaces, -1.0 if obj_left else 1.0, t)    # square on: away from the touched side
     return trigger
 
 
@@ -428,7 +559,7 @@ def light_gradient(samples: list[tuple[float, float, float]], min_spread: float,
 class TaskModule:
     """Level 2: the current task (docs/decisions.md D8: wall following, seeking / avoiding light, exploring)."""
 
-    inputs = ("ir", "whisker", "light", "pose", "goal", "echoes")
+    inputs = ("ir", "whisker", "light", "pose", "goal", "echoes", "mapped")
     outputs = ("move",)
 
     def __init__(self, task: str, t: Tuning) -> None:
@@ -448,6 +579,8 @@ class TaskModule:
         self.detour_until = -math.inf
         self.weave = 0.0
         self.weave_at: float | None = None
+        self.dark_level: float | None = None     # log lux of the flat samples while no light shows (dark())
+        self.dimmest = math.inf                  # the lowest log lux sampled (the room's ambient light)
 
     def step(self, inputs: Mapping[str, Any], now: float) -> Outputs:
         if self.task in ("seek_light", "avoid_light"):
@@ -538,15 +671,34 @@ class TaskModule:
             return
         self.light_seq = light[0]
         self.samples = (self.samples + [light[1:]])[-self.t.light_samples:]
+        if self.task == "seek_light":                 # avoiding light, a flat reading is where it wants to be
+            self._darkness()
+        if self.dark_level is not None:
+            return
         fit = light_gradient(self.samples, self.t.light_min_spread_m, self.gradient)
         if fit is not None and self.gradient is None:
             self.plan = None                          # the probe has done its job: head for the light now
         self.gradient = fit or self.gradient
 
-    def dark(self) -> bool:
-        """A full set of light samples that differ by less than light_flat_log: no gradient to follow."""
+    def _darkness(self) -> None:
+        """Enter or leave the dark state (dark()) with the newest sample."""
         logs = [s[2] for s in self.samples]
-        return len(logs) >= self.t.light_samples and max(logs) - min(logs) < self.t.light_flat_log
+        self.dimmest = min(self.dimmest, logs[-1])
+        flat = self.t.light_flat_log
+        if self.dark_level is None and len(logs) >= self.t.light_samples \
+                and max(logs) < min(logs) + flat and max(logs) < self.dimmest + flat:
+            self.dark_level = max(logs)               # no light to climb: the gradient so far was noise
+            self.gradient = None
+        elif self.dark_level is not None and logs[-1] >= self.dark_level + flat:
+            self.dark_level = None                    # a light shows: fit afresh, with no prior from the noise
+
+    def dark(self) -> bool:
+        """No light to follow: a full set of samples spanned less than light_flat_log (a few LSC steps of
+        noise) at the dimmest level seen (flat and bright is at the lamp, or the LSC saturated there: stay),
+        and no sample since has read that much brighter than they did. The hysteresis matters: a flat
+        reading's noise spans 1-3 steps, and a state that flipped with it sent the robot after a gradient of
+        noise (light_behind_wall seed 2, issue 17)."""
+        return self.dark_level is not None
 
     def _seek_light(self, i: Mapping[str, Any], now: float) -> MovCmd:
         return self._light(i, now, sign=1.0)
@@ -593,10 +745,13 @@ class TaskModule:
 
     def _detour(self, i: Mapping[str, Any], pose: tuple[float, float, float], bearing: float, now: float) -> float:
         """seed 5.1.2: the heading closest to `bearing` whose corridor (body and legs) the echoes of the last
-        seconds leave clear for t.light_clear_m; the side a detour took is kept for t.light_detour_hold_s
-        after the last blocked heading (round an obstacle on one side, no dithering at its corner)."""
+        seconds and the obstacles on the map (3.3.2) leave clear for t.light_clear_m; the side a detour took is
+        kept for t.light_detour_hold_s after the last blocked heading (round an obstacle on one side, no
+        dithering at its corner). The map matters at a long obstacle: the echo memory keeps its face only
+        for seconds, a heading it no longer shows blocked turned the robot back into the face and avoidance
+        turned it away again, for 50-100 s at seek_light's block (seeds 14, 16, issue 17)."""
         t = self.t
-        echoes = i.get("echoes")
+        echoes = tuple(i.get("echoes") or ()) + tuple(i.get("mapped") or ())
         if now > self.detour_until:
             self.detour_side = 0.0
         if not echoes:
@@ -635,7 +790,8 @@ def np3_network(clock: Clock, task: str = "forward", tuning: Tuning | None = Non
     net = Network(clock)
     reflexes = [   # level 0; declared weakest first: a later suppressor sits closer to the MMC and wins
         ReflexModule("leg_blocked", REFLEXES, ("leg_blocked",), leg_blocked_trigger(t)),   # seed 6.1
-        ReflexModule("contact", REFLEXES, ("whisker", "ir"), contact_trigger(t)),          # seed 3.2.12, 3.2.13, 5.2
+        ReflexModule("contact", REFLEXES, ("whisker", "ir", "pose", "echoes"),
+                     contact_trigger(t)),                                                  # seed 3.2.12, 3.2.13, 5.2
         ReflexModule("pit", REFLEXES, ("pit",), pit_trigger(t)),                           # seed 1.2.2
         ReflexModule("tilt", REFLEXES, ("tilt",), tilt_trigger(t)),                        # seed 3.2.14
         ReflexModule("ir_fault", REFLEXES, ("ir_fault",), stop_while("ir_fault")),        # seed 6.2: IR -> stop

@@ -51,7 +51,8 @@ def _mean(values: list[int]) -> int:
 
 def limit_in(data: Quantizer, alarm: type[M.Message], raw_limit: int) -> int:
     """A SET_ALARM limit in the data field's raw steps (through physical units: the encodings may differ)."""
-    return data.raw(quantizer(alarm, "limit").phys(raw_limit))
+    (limit,) = [a.limit for a in M.ALARM_THRESHOLDS.values() if a.message is alarm]   # spec compared_with
+    return data.raw(quantizer(alarm, limit).phys(raw_limit))
 
 
 class AlarmLimit:

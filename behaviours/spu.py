@@ -29,7 +29,7 @@ from behaviours import tuning as T
 from behaviours.post import PostMaster
 from behaviours.runtime import PRIORITY_REFLEX, Runtime, slaves_of
 from behaviours.sensors import ABOVE, BELOW, BEYOND, AlarmLimit, limit_in
-from behaviours.units import XMIT_DATA_OF, age_byte, quantizer, record_byte
+from behaviours.units import XMIT_DATA_OF, age_byte, record_byte, values_quantizer
 
 # each sensor role's STATUS_ACK layout; the range sensors are the ones with UNRELIABLE (3.2.11, 3.2.13)
 STATUS_OF = {role: cls for cls in (M.StatusAckRange, M.StatusAckOrder) for role in cls.SENDERS}
@@ -40,18 +40,13 @@ _KIND_NAME = {int(k): k.name.lower() for k in RecordKind}
 
 
 def channels(role: str, msg: Any) -> dict[int, int]:
-    """A sensor's reply as {record channel: raw value} (the record contract: IRRC beam, ISC axis,
-    TSC probe, USRC head angle; 0 otherwise)."""
-    if role == "USRC":
-        return {msg.angle: msg.distance}
-    if role == "IRRC":
-        return {0: msg.left, 1: msg.center, 2: msg.right}
-    if role == "ISC":
-        return {int(IscAxis.LONGITUDINAL): msg.longitudinal, int(IscAxis.TRANSVERSE): msg.transverse}
-    if role == "TSC":
-        return {msg.channel: msg.temperature}
-    (only,) = XMIT_DATA_OF[role].FIELDS           # TPSC, LSC, PSC: a record of one field
-    return {0: getattr(msg, only.name)}
+    """A sensor's reply as {record channel: raw value} (spec record_values: the channel is a field's position,
+    IRRC beam, ISC axis, or the value of the record_channel field, USRC head angle, TSC probe)."""
+    r = M.RECORD_VALUES[role]
+    if r.channel is not None:
+        (only,) = r.fields
+        return {getattr(msg, r.channel): getattr(msg, only)}
+    return {ch: getattr(msg, f) for ch, f in enumerate(r.fields)}
 
 
 class Record(NamedTuple):
@@ -93,12 +88,13 @@ class SonarScan:
 
 def alarm_setup() -> list[tuple[str, M.Message, list[tuple[int, AlarmLimit]]]]:
     """The SET_ALARM frames for each sensor role with the limits (in the data's raw steps) they set, per channel."""
-    ir, isc = quantizer(M.XmitDataIrrc, "center"), quantizer(M.XmitDataIsc, "longitudinal")
-    tsc, lsc, psc = (quantizer(M.XmitDataTsc, "temperature"), quantizer(M.XmitDataLsc, "brightness"),
-                     quantizer(M.XmitDataPsc, "voltage"))
+    # each limit in the raw steps of the record values it is compared with (spec compared_with)
+    q = {role: values_quantizer(a.data) for role, a in M.ALARM_THRESHOLDS.items()}
+    ir, isc, tsc, lsc, psc = (q[role] for role in ("IRRC", "ISC", "TSC", "LSC", "PSC"))
     out: list[tuple[str, M.Message, list[tuple[int, AlarmLimit]]]] = []
     m: M.Message = M.SetAlarmIrrc.from_phys(limit=T.SPU_ALARM_IRRC_CM)           # seed 3.2.13
-    out.append(("IRRC", m, [(b, AlarmLimit(limit_in(ir, M.SetAlarmIrrc, m.limit), BELOW, 0)) for b in range(3)]))
+    beams = range(len(M.ALARM_THRESHOLDS["IRRC"].data.fields))                   # one limit for every beam
+    out.append(("IRRC", m, [(b, AlarmLimit(limit_in(ir, M.SetAlarmIrrc, m.limit), BELOW, 0)) for b in beams]))
     for axis in IscAxis:                                                          # seed 3.2.14
         m = M.SetAlarmIsc.from_phys(channel=int(axis), limit=T.SPU_ALARM_ISC_DEG[int(axis)])
         out.append(("ISC", m, [(int(axis), AlarmLimit(limit_in(isc, M.SetAlarmIsc, m.limit), BEYOND, 0))]))
@@ -148,6 +144,7 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
         self.posting = False
         self.polling = False
         self.cycle_i = self.status_i = 0
+        self.polled: str | None = None      # the role of the poll cycle's last XMIT_DATA
         self.next_status = 0.0
         self.counts = {"value": 0, "alarm": 0, "status": 0, "ignored": 0, "silent": 0, "untrusted": 0, "coalesced": 0}
         self.values: dict[str, int] = {}
@@ -166,6 +163,10 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
     def post_done(self, missing: list[int]) -> None:
         self.posting = False
         self.live = [r for r, a in self.sensors.items() if a not in missing]
+        for role in T.SPU_FIRST_POLL:  # seed 5.2: the close range first (a wall touched at power-on: the TPSC's
+            if role in self.live:      # DATA_RDY then found no SPU to fetch it); the NP3 does not step before
+                self.request(self.sensors[role], M.XmitData(), (XMIT_DATA_OF[role],),
+                             lambda s, m, role=role: self.got(role, m, False), lambda role=role: self.missed(role))
         if "USRC" in self.live and not T.SPU_SCAN_AHEAD_DEG:   # seed 3.2.11: no scan of its own: the sonar
             self.free_run.add("USRC")                          # scans its circle and announces each sector
             self.request(self.sensors["USRC"], M.FreeRun())
@@ -198,6 +199,7 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
             return
         role = cycle[self.cycle_i % len(cycle)]
         self.cycle_i += 1
+        self.polled = role
         if role == "USRC":
             self.sonar_step()
             return
@@ -245,7 +247,7 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
             return
         # spec reflexes (seed 5.2): a reflex source's data is fetched before anything still waiting out its defer
         priority = max(PRIORITY_REFLEX if self.net.reflex_from(src) is not None else 0, 1)
-        if self.waiting(src, M.XmitData, priority):
+        if self.waiting(src, M.XmitData, 0 if role in self.free_run else priority):   # its fetch may wait its turn
             # seed 3.2.2 / arbitration model: one request per slave, served in the order they got through. An urgent
             # fetch still waiting gets the newest data; queueing one per DATA_RDY let the free-running USRC pile up
             # nine and every other sensor wait behind them (worst_contention seed 6: past K on the sensor bus)
@@ -255,8 +257,12 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
             if self.status.get(role, _IN_ORDER) != _IN_ORDER:
                 self.counts["ignored"] += 1       # seed 6.2: an untrustworthy sensor's data is ignored
                 return
+            # seed 5.2: ahead of the poll cycle, but not of a poll already waiting: the USRC announcing close
+            # echoes every ~0.12 s kept the IR poll behind a new fetch for 2.7 s while the robot walked into a
+            # corner (start_in_corner); now the fetches and the polls take turns
+            polling = self.polled is not None and self.waiting(self.sensors[self.polled], M.XmitData)
             self.request(src, M.XmitData(), (XMIT_DATA_OF[role],), lambda s, m, role=role: self.got(role, m, False),
-                         lambda role=role: self.missed(role), urgent=True)
+                         lambda role=role: self.missed(role), urgent=not polling)
             return
         event = role != "TPSC"                     # anything else announces an alarm or a status change
         if role in RANGE:                          # its status first: is the data to be trusted (6.2)

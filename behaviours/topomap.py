@@ -24,7 +24,7 @@ from __future__ import annotations
 import heapq
 import math
 from collections import deque
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterable, Sequence
 
@@ -117,6 +117,13 @@ class OccupancyGrid:
             self.logodds[k] = self.limit
             self.seen[k] = 1
             self.barriers.add((i, j))
+
+    def occupied_near(self, x: float, y: float, radius_m: float) -> list[tuple[float, float]]:
+        """Centres of the occupied cells (walls, blocks, pit edges, refused slopes) within `radius_m` of (x, y):
+        what the map remembers round the robot after its short echo memory has let it go."""
+        (i0, j0), (i1, j1) = self.cell(x - radius_m, y - radius_m), self.cell(x + radius_m, y + radius_m)
+        return [c for j in range(max(0, j0), min(self.ny, j1 + 1)) for i in range(max(0, i0), min(self.nx, i1 + 1))
+                if self.state(i, j) == OCCUPIED and math.dist(c := self.centre(i, j), (x, y)) <= radius_m]
 
     def mark_free(self, x: float, y: float, radius_m: float) -> None:
         """The robot stands here: the cells under its body are free (and seen)."""
@@ -357,6 +364,11 @@ class TopoMap:
                     heapq.heappush(todo, (d + h(by_id[n]), n))
         return None
 
+    @staticmethod
+    def length(start: tuple[float, float], route: Sequence[tuple[float, float]]) -> float:
+        """The length (m) of a route's waypoints walked from `start`."""
+        return sum(math.dist(a, b) for a, b in zip([start, *route], route))
+
     def coverage(self) -> float:
         """Share of the room polygon's cells that some beam has crossed or hit (0..1)."""
         if not self.room:
@@ -370,14 +382,35 @@ class TopoMap:
                     seen += g.seen[j * g.nx + i]
         return seen / total if total else 0.0
 
+    def _open_unknown(self, i: int, j: int) -> bool:
+        """An unknown cell with no occupied neighbour (one next to an occupied cell is most likely a wall cell
+        a grazing beam missed)."""
+        g = self.grid
+        return g.inside(i, j) and g.state(i, j) == UNKNOWN and all(
+            g.state(i + di, j + dj) != OCCUPIED for di, dj in _N8)
+
+    def is_frontier(self, c: tuple[int, int]) -> bool:
+        """A free cell bordering open unknown space."""
+        return self.grid.state(*c) == FREE and any(self._open_unknown(c[0] + di, c[1] + dj) for di, dj in _N8)
+
+    def frontier_near(self, x: float, y: float, radius_m: float) -> bool:
+        """Some frontier cell lies within `radius_m` of (x, y): a frontier chosen there is not yet explored."""
+        g = self.grid
+        (i0, j0), (i1, j1) = g.cell(x - radius_m, y - radius_m), g.cell(x + radius_m, y + radius_m)
+        return any(self.is_frontier((i, j)) and math.dist(g.centre(i, j), (x, y)) <= radius_m
+                   for j in range(j0, j1 + 1) for i in range(i0, i1 + 1))
+
     def frontier(self, x: float, y: float, min_size: int = 5, min_path_m: float = 0.0,
-                 size_weight: float = 0.0) -> Frontier | None:
+                 size_weight: float = 0.0, exclude: Sequence[tuple[float, float]] = (),
+                 exclude_m: float = 0.0) -> Frontier | None:
         """The nearest (by free path) cluster of free cells bordering open unknown space; None when explored.
 
         Clusters smaller than `min_size` cells are gaps between diverging beams,
         not frontiers; cells nearer than `min_path_m` are where the robot already is.
         With `size_weight` a cluster's path counts that many metres less per cell of its edge (a wide opening
         onto unknown space is worth a longer walk than a sliver, the usual gain-minus-cost frontier choice).
+        Cells within `exclude_m` of an `exclude` point do not count: frontiers the robot gave up on (no
+        revisits).
         """
         g = self.grid
         start = g.cell(x, y)
@@ -393,15 +426,10 @@ class TopoMap:
                     dist[n] = dist[(i, j)] + g.res * math.hypot(di, dj)
                     queue.append(n)
 
-        def open_unknown(i: int, j: int) -> bool:
-            # an unknown cell next to an occupied one is most likely a wall cell a grazing beam missed
-            return g.inside(i, j) and g.state(i, j) == UNKNOWN and all(
-                g.state(i + di, j + dj) != OCCUPIED for di, dj in _N8)
+        def excluded(c: tuple[int, int]) -> bool:
+            return any(math.dist(g.centre(*c), p) < exclude_m for p in exclude)
 
-        def is_frontier(c: tuple[int, int]) -> bool:
-            return g.state(*c) == FREE and any(open_unknown(c[0] + di, c[1] + dj) for di, dj in _N8)
-
-        cells = {c for c in dist if dist[c] >= min_path_m and is_frontier(c)}
+        cells = {c for c in dist if dist[c] >= min_path_m and self.is_frontier(c) and not excluded(c)}
         best: Frontier | None = None
         while cells:
             seed = min(cells)
@@ -425,8 +453,10 @@ class TopoMap:
         return best
 
     # -- picture --------------------------------------------------------------------
-    def save_png(self, path: str | Path, px_per_cell: int = 4) -> Path:
-        """Grid (unknown grey, free white, occupied black), room outline, edges, places, robot path."""
+    def save_png(self, path: str | Path, px_per_cell: int = 4,
+                 given_up: Sequence[tuple[float, float]] = ()) -> Path:
+        """Grid (unknown grey, free white, occupied black), room outline, edges, places, robot path, the plan
+        (green, to a square at its goal) and frontiers given up (FrontierTarget, purple crosses)."""
         from PIL import Image, ImageDraw
 
         g, s = self.grid, px_per_cell
@@ -458,9 +488,63 @@ class TopoMap:
             draw.line(pts, fill=(0, 170, 60), width=3)
             (gx, gy), r = pts[-1], max(5, 2 * s)
             draw.rectangle((gx - r, gy - r, gx + r, gy + r), outline=(0, 170, 60), width=2)
+        for p in given_up:
+            (cx, cy), r = px(*p), max(4, s)
+            draw.line((cx - r, cy - r, cx + r, cy + r), fill=(150, 40, 170), width=2)
+            draw.line((cx - r, cy + r, cx + r, cy - r), fill=(150, 40, 170), width=2)
         out = Path(path)
         img.save(out, format="PNG")
         return out
+
+
+@dataclass
+class FrontierTarget:
+    """seed 3.3.2: the frontier the robot's routes lead to, kept from one replan to the next.
+
+    Choosing the nearest frontier afresh at every replan swapped between frontiers as the map grew and
+    reached none (light_behind_wall, issue 17). So the target is kept, and routed to again on the rebuilt
+    map at every replan (the map changed, so may the route), until it is reached (within `exclude_m`: a
+    frontier by a wall may lie where the body cannot stand, light_behind_wall seed 4 spent 40 s 0.45 m from
+    one), explored (no frontier cell left within `exclude_m`), refuted (no route leads there) or not
+    approached (its route not `progress_m` shorter for `patience_s`). Then it is given up, frontier cells near it no longer count (no revisits)
+    and the next frontier is chosen. When every frontier left has been given up, they count again (the
+    map has grown since: start over rather than stop).
+    """
+
+    exclude_m: float
+    progress_m: float
+    patience_s: float
+    target: tuple[float, float] | None = None
+    left_m: float = math.inf                  # the shortest route to the target so far
+    closer_at: float = 0.0                    # when that last shortened
+    given_up: list[tuple[float, float]] = field(default_factory=list)
+
+    def route(self, topo: TopoMap, x: float, y: float, now: float, reached_m: float, min_size: int = 5,
+              min_path_m: float = 0.0, size_weight: float = 0.0) -> list[tuple[float, float]]:
+        """The route from (x, y) to the target over `topo` (rebuilt by the caller), waypoints nearer than
+        `reached_m` dropped; [] when no frontier is left to explore. The frontier arguments: TopoMap.frontier."""
+        for _choice in range(3):                  # the kept target, else (given up) a new one, else start over
+            if self.target is None:
+                f = topo.frontier(x, y, min_size=min_size, min_path_m=min_path_m, size_weight=size_weight,
+                                  exclude=self.given_up, exclude_m=self.exclude_m)
+                if f is None and self.given_up:       # all explored or given up: the map has grown since,
+                    self.given_up.clear()             # so start over rather than stop
+                    continue
+                if f is None:
+                    return []
+                self.target, self.left_m, self.closer_at = (f.x, f.y), math.inf, now
+            route = topo.route((x, y), self.target) or []
+            while route and math.dist(route[0], (x, y)) < reached_m:
+                route.pop(0)
+            left = topo.length((x, y), route)
+            if left < self.left_m - self.progress_m:
+                self.left_m, self.closer_at = left, now
+            if route and math.dist(self.target, (x, y)) > self.exclude_m \
+                    and topo.frontier_near(*self.target, self.exclude_m) and now - self.closer_at <= self.patience_s:
+                return route
+            self.given_up.append(self.target)
+            self.target = None
+        return []
 
 
 def full_scan(x: float, y: float, heading_deg: float, ranges: Sequence[float | None],
@@ -469,5 +553,5 @@ def full_scan(x: float, y: float, heading_deg: float, ranges: Sequence[float | N
     return [Reading(x, y, heading_deg, k * step_deg, d) for k, d in enumerate(ranges)]
 
 
-__all__ = ["Reading", "Place", "Frontier", "OccupancyGrid", "TopoMap", "full_scan", "line_cells", "ray_cells",
+__all__ = ["Reading", "Place", "Frontier", "FrontierTarget", "OccupancyGrid", "TopoMap", "full_scan", "line_cells", "ray_cells",
            "point_in_polygon", "UNKNOWN", "FREE", "OCCUPIED", "USRC_MAX_RANGE_M", "USRC_MIN_RANGE_M"]

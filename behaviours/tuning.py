@@ -66,11 +66,19 @@ JAC_WATCHDOG_S = 1.0          # no set point this long (5 refresh periods): the 
 
 # --- NP3 (seed 3.2.3, 3.3.2, 5.1-5.2, 6, docs/decisions.md D8): the subsumption network's numbers, all CHOICE
 NP3_PERIOD_S = 0.1            # the network is evaluated every 100 ms (5.2: reactions well within 1 s)
+NP3_START_LOOK_S = 1.0        # after INIT no step until the IR and whiskers reported (the SPU polls them first, see
+                              # SPU_FIRST_POLL), at most this long
 NP3_REFLEX_HOLD_S = 0.5       # suppressor time constants: reflexes ...
 NP3_AVOID_HOLD_S = 0.3        # ... and obstacle avoidance keep the lower layers cut this long
-NP3_CONTACT_BACK_S = 1.6      # contact (whisker, IR very close): back off one tripod cycle ...
-NP3_CONTACT_TURN_S = 2.4      # ... then turn away (about 60 degrees)
-NP3_CONTACT_SIDE_TURN_S = 1.6 # one whisker only, IR clear: just turn away (about 40 degrees)
+NP3_CONTACT_BACK_S = 1.6      # contact (whisker, IR very close) with the surface ahead: back off at least one
+                              # tripod cycle (longer if the body's corners would sweep into it turning) ...
+NP3_CONTACT_AHEAD_DEG = 60.0  # ... "ahead": its normal (IR line fit) within this of the heading ...
+NP3_CONTACT_CLEAR_DEG = 20.0  # ... then turn until the surface's normal is this far behind the side (walk away),
+NP3_CONTACT_MIN_TURN_DEG = 30.0   # ... at least this far;
+NP3_CONTACT_WHISKER_NORMAL_DEG = 60.0  # a whisker alone (IR beams clear): the surface taken to face this far aside
+NP3_CONTACT_CORNER_M = 0.01   # the IR centre point this far behind the line through the side points: a corner;
+NP3_CONTACT_CORNER_NORMAL_DEG = 45.0  # ... the side beams alone see a corner: its walls taken to face this far aside
+NP3_CONTACT_NEAR_M = 0.1      # ... a remembered echo beside the body this close to it: a wall alongside
 NP3_IR_CONTACT_M = 0.03       # an IR echo this close counts as contact
 NP3_AVOID_CENTRE_M = 0.08     # avoidance: the centre beam sees something this close ...
 NP3_AVOID_SIDE_M = 0.06       # ... or a side beam this close -> turn away
@@ -104,6 +112,11 @@ NP3_EXPLORE_TURN_S = 2.4      # ... turning this long
 NP3_GOAL_REACHED_M = 0.4      # a goal this close (dead reckoning) is reached
 NP3_PLAN_MIN_PATH_M = 1.5    # explore: a route over the map to the nearest frontier at least this far (3.3.2) ...
 NP3_PLAN_MIN_FRONTIER = 20    # ... of at least this many cells (smaller ones are gaps between sonar beams)
+NP3_PLAN_EXCLUDE_M = 0.5      # ... committed to until no frontier cell is left this near it (explored) or no
+                              # route leads there; frontier cells this near a frontier given up on do not count
+NP3_PLAN_PROGRESS_M = 0.3     # ... and given up when its route has not shortened by this much ...
+NP3_PLAN_PATIENCE_S = 40.0    # ... for this long (4 replans: walked round walls at 0.09 m/s, a route shortens faster)
+NP3_PLAN_CHANGED_S = 1.0      # ... and planned again this soon after a pit or refused slope joins the map
 NP3_SEEK_FRONTIER_WEIGHT_M = 0.1  # seeking a light no sample shows: a frontier cell is worth this much path (the
                               # widest opening onto the unknown, where a lamp behind a wall is, before the nearest)
 NP3_HEADING_TOL_DEG = 20.0    # steering: turn on the spot while the goal is further off the axis than this
@@ -116,8 +129,13 @@ NP3_LIGHT_WEAVE_S = 8.0       # ... changing side this often (the fit needs samp
 NP3_LIGHT_CLEAR_M = 0.6       # ... on the heading nearest the target with this much clear in the echo memory,
 NP3_LIGHT_DETOUR_STEP_DEG = 20.0  # ... tried in steps this wide either side (bug-style round an obstacle)
 NP3_LIGHT_DETOUR_HOLD_S = 10.0   # ... keeping a detour's side this long after the last blocked heading
-NP3_LIGHT_FLAT_LOG = 0.02     # seeking light: samples spanning less than this (log10 lux, ~1 LSC step of 3.6 %)
-                              # show no light to climb (a lamp shaded by a wall): explore the map instead (3.3.2)
+NP3_MAPPED_NEAR_M = 1.0       # ... the map's occupied cells this near the robot count as obstacles too (3.3.2;
+                              # beyond light_clear_m plus the body's half length: what a detour heading can meet)
+NP3_LIGHT_FLAT_STEPS = 5      # seeking light: samples spanning fewer than this many LSC steps (1/64 decade, 3.6 %
+                              # each, from the spec) show no light to climb (a lamp shaded by a wall): explore the map
+                              # instead (3.3.2) until a sample is that much brighter. Measured, issue 17: at 5 lx
+                              # ambient a flat reading's noise spans 1-3 steps (1 step flipped "dark" on and off);
+                              # the lamp seen past a wall's end reads 6x-16x the ambient (40-60 steps)
 NP3_MAP_SIZE_M = 12.0         # topological map: a square this wide around the start ...
 NP3_MAP_CELL_M = 0.1          # ... in cells this wide
 NP3_SONAR_BEAM_DEG = 15.0     # width a sonar echo is spread over on the map (40 kHz transducer cone)
@@ -151,6 +169,7 @@ SPU_SCAN_ROUND_EVERY = 3      # ... and every 3rd angle one of the rest of the c
 SPU_SCAN_ROUND_STEP_DEG = 15  # ... in steps of the beam's width, round from the sweep's edge ...
 SPU_SCAN_SIDE_DEG = (90, -90, 75, -75, 105, -105)   # ... but mostly the sides, left and right in turn, where a
 SPU_SCAN_SIDES_PER_ROUND = 2  # wall alongside is followed: 2 side angles, then one of the rest of the circle
+SPU_FIRST_POLL = ("IRRC", "TPSC")  # after POST, before the alarm set-up: what touches or almost touches the body
 SPU_STATUS_EVERY_S = 0.5      # one STATUS_REQ to a range sensor (USRC, IRRC in turn) this often (6.2)
 SPU_SILENT_POLLS = 1          # failed transactions in a row (each with the retry) before OUT_OF_ORDER: the seed 3.2.2 rule
 SPU_XMIT_RETRY_S = 0.3        # a pending record not granted this long: XMIT_REQ again (the request may be lost)

@@ -75,3 +75,15 @@ RECORD_AGE = quantizer(_M.XmitRecord, "age")
 def age_byte(seconds: float) -> int:
     """A record's age field for a value measured `seconds` ago (older than the field reaches: its top)."""
     return RECORD_AGE.raw(max(0.0, seconds))
+
+
+def values_quantizer(values: _M.RecordValues) -> Quantizer:
+    """The conversion of a sensor's record values (spec record_values: one encoding for all its fields)."""
+    return quantizer(values.message, values.fields[0])
+
+
+# seed 3.2.2, 6.2: per sensor role whose records carry a number (the TPSC's carry contact flags), the conversion of
+# the value byte (a record's value is the raw value of one of its record_values, signed as two's complement)
+RECORD_QUANTIZER: dict[str, Quantizer] = {
+    role: values_quantizer(r) for role, r in _M.RECORD_VALUES.items()
+    if next(f for f in r.message.FIELDS if f.name == r.fields[0]).conv is not None}

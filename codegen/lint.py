@@ -13,10 +13,8 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
-import jsonschema
-
 from arachnae.errors import UserError, located
-from arachnae.validation import Validator
+from arachnae.validation import field_name, schema_errors
 from codegen.encoding import Linear, Log10, to_fraction
 from codegen.generate import LANGUAGES
 from codegen.model import Checksum, Spec, enum_values_of
@@ -50,38 +48,13 @@ def _lint_text(path: Path, doc: Any, node: Any, where: list[Any], report: Report
     for key, value in items:
         for text in (key, value):
             if isinstance(text, str) and any(0xD800 <= ord(ch) <= 0xDFFF for ch in text):
-                report.add(path, doc, where + [key], f"{'.'.join(map(str, where + [key]))}: {text!r} contains a lone surrogate, not text")
+                report.add(path, doc, where + [key], f"{field_name(where + [key])}: {text!r} contains a lone surrogate, not text")
         _lint_text(path, doc, value, where + [key], report)
 
 
 def _schema_check(path: Path, doc: Any, schema_name: str, report: Report) -> None:
-    validator = Validator(load_yaml(SCHEMA_DIR / schema_name))
-    by_field: dict[tuple[str, ...], list[jsonschema.ValidationError]] = {}
-    for err in sorted(validator.iter_errors(doc), key=lambda e: list(map(str, e.absolute_path))):
-        by_field.setdefault(tuple(map(str, err.absolute_path)), []).append(err)
-    for errs in by_field.values():            # one line per field: its first problem, or all its missing keys
-        where = list(errs[0].absolute_path)
-        field = ".".join(str(p) for p in where) or "(top level)"
-        missing = [e.message.split(" is a required")[0] for e in errs if e.validator == "required"]
-        text = f"{', '.join(missing)} {'are' if len(missing) > 1 else 'is'} missing" if missing else _schema_message(errs[0])
-        report.add(path, doc, where, f"{field}: {text}")
-
-
-def _schema_message(err: jsonschema.ValidationError) -> str:
-    if err.validator == "additionalProperties":
-        return err.message.replace("Additional properties are not allowed", "unknown key(s)")
-    if err.validator == "required":
-        return err.message.replace("is a required property", "is missing")
-    if err.validator == "type":
-        return f"{err.instance!r} is not {_TYPE_WORDS.get(str(err.validator_value), err.validator_value)}"
-    if err.validator == "pattern" and "description" in err.schema:
-        return f"{err.instance!r} is not {err.schema['description']}"
-    return err.message
-
-
-_TYPE_WORDS = {"integer": "an integer", "number": "a finite number", "string": "a string", "boolean": "true or false",
-               "object": "a mapping", "array": "a list", "['number', 'string']": "a finite number or a fraction 'a/b'",
-               "['string', 'null']": "a string or null"}
+    """Structure, worded as every other schema check of the toolkit (arachnae.validation: `file:line: field: problem`)."""
+    report.problems += [one_line(str(e)) for e in schema_errors(doc, load_yaml(SCHEMA_DIR / schema_name))]
 
 
 def check_documents(nodes_path: Path, messages_path: Path) -> tuple[dict, dict]:
@@ -274,6 +247,80 @@ def _lint_reply(path: Path, doc: dict, i: int, m: dict, report: Report) -> None:
             report.add(path, doc, at, f"{m['name']}: {', '.join(both)} already answer(s) {m['reply_to']} with {other['name']}")
 
 
+_ENCODING_KEYS = ("type", "bits", "unit", "scale", "offset", "log10", "range", "enum", "flags")
+
+
+def _encoding(f: dict) -> dict:
+    """What decides a field's raw value and its meaning: two fields with equal encodings read alike."""
+    return {k: str(f.get(k, 8 if k == "bits" else None)) for k in _ENCODING_KEYS}
+
+
+def _lint_record_values(path: Path, doc: dict, i: int, m: dict, report: Report) -> None:
+    """seed 3.2.2, 6.2: a sensor record's `record_values` are fields of it, one encoding, each fits the XMIT_RECORD's
+    one value byte; `record_channel` is another integer field, for a record of one value."""
+    at, name = ["messages", i], m["name"]
+    fields = {f["name"]: f for f in m.get("fields", [])}
+    if "record_channel" in m and "record_values" not in m:
+        report.add(path, doc, at + ["record_channel"], f"{name}: record_channel needs record_values")
+    if "record_values" not in m:
+        return
+    if not m.get("record"):
+        report.add(path, doc, at + ["record_values"], f"{name}: record_values is for records (`record: true`)")
+    if len(m["from"]) != 1:
+        report.add(path, doc, at + ["record_values"], f"{name}: record_values belongs to one role's data, not {'/'.join(m['from'])}")
+    values = [fields.get(v) for v in m["record_values"]]
+    for j, (v, f) in enumerate(zip(m["record_values"], values)):
+        if f is None:
+            report.add(path, doc, at + ["record_values", j], f"{name}: record_values names '{v}', which is no field of it")
+        elif f["type"] not in ("uint", "int", "flags", "enum") or "count" in f or f.get("bits", 8) > 8:
+            report.add(path, doc, at + ["record_values", j], f"{name}.{v}: a record carries one value byte, "
+                                                            f"not a {f.get('bits', 8)}-bit {f['type']}{' array' if 'count' in f else ''}")
+        elif _encoding(f) != _encoding(values[0] or f):
+            report.add(path, doc, at + ["record_values", j], f"{name}.{v}: encoded unlike {m['record_values'][0]}; "
+                                                            f"a record's values share one encoding")
+    channel = m.get("record_channel")
+    if channel is None:
+        return
+    f = fields.get(channel)
+    if f is None or f["type"] not in ("uint", "enum") or "count" in f:
+        report.add(path, doc, at + ["record_channel"], f"{name}: record_channel '{channel}' is no unsigned integer field of it")
+    elif channel in m["record_values"]:
+        report.add(path, doc, at + ["record_channel"], f"{name}: record_channel '{channel}' is one of its record_values")
+    elif len(m["record_values"]) != 1:
+        report.add(path, doc, at + ["record_channel"], f"{name}: record_channel gives the channel of one value, "
+                                                      f"not of {len(m['record_values'])}")
+
+
+def _lint_compared(path: Path, doc: dict, i: int, m: dict, report: Report) -> None:
+    """seed 3.2.13-3.2.17: a threshold `compared_with` a data message goes to the role that sends that data, has its
+    unit and lies within its values' range; one threshold per role."""
+    for k, f in enumerate(m.get("fields", [])):
+        if "compared_with" not in f:
+            continue
+        at, fname = ["messages", i, "fields", k, "compared_with"], f"{m['name']}.{f['name']}"
+        data = next((d for d in doc["messages"] if d["name"] == f["compared_with"]), None)
+        if data is None or "record_values" not in data:
+            report.add(path, doc, at, f"{fname}: compared_with '{f['compared_with']}', which is no message with record_values")
+            continue
+        if set(m["to"]) != set(data["from"]):
+            report.add(path, doc, at, f"{fname}: goes to {'/'.join(m['to'])}, but {data['name']} comes from {'/'.join(data['from'])}")
+        value = next((d for d in data.get("fields", []) if d["name"] == data["record_values"][0]), None)
+        if value is None:
+            continue                      # reported with the data message
+        if f.get("unit") != value.get("unit"):
+            report.add(path, doc, at, f"{fname}: unit {f.get('unit', 'none')!r}, but {data['name']}.{value['name']} "
+                                      f"is in {value.get('unit', 'none')!r}")
+        elif "range" in f and "range" in value:
+            lo, hi = (to_fraction(v) for v in f["range"])
+            vlo, vhi = (to_fraction(v) for v in value["range"])
+            if lo < vlo or hi > vhi:
+                report.add(path, doc, at, f"{fname}: range [{_num(lo)}, {_num(hi)}] reaches beyond "
+                                          f"{data['name']}.{value['name']}'s [{_num(vlo)}, {_num(vhi)}]")
+        for other in doc["messages"][:i]:
+            if any(g.get("compared_with") == f["compared_with"] for g in other.get("fields", [])):
+                report.add(path, doc, at, f"{fname}: {other['name']} already sets the threshold for {data['name']}")
+
+
 def _lint_messages(path: Path, doc: dict, nodes_doc: dict, roles: set[str], report: Report, check_routes: bool) -> None:
     _lint_checksum(path, doc, report)
     _lint_enum_subsets(path, doc, report)
@@ -300,6 +347,8 @@ def _lint_messages(path: Path, doc: dict, nodes_doc: dict, roles: set[str], repo
             _lint_reply(path, doc, i, m, report)
         if "carried_in" in m:
             _lint_carried(path, doc, i, m, report)
+        _lint_record_values(path, doc, i, m, report)
+        _lint_compared(path, doc, i, m, report)
         if m.get("record") and (len(m["to"]) != 1 or m.get("broadcast")):
             report.add(path, doc, ["messages", i, "record"], f"{m['name']}: a record goes to one master role, not {'/'.join(m['to'])}"
                        f"{' or a broadcast' if m.get('broadcast') else ''}")

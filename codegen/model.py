@@ -221,6 +221,7 @@ class Field:
     count_max: int = 0
     origin: str = "seed"
     doc: str = ""
+    compared_with: str | None = None   # a threshold compared with that data message's record_values
 
     @property
     def signed(self) -> bool:
@@ -275,6 +276,8 @@ class Message:
     record: bool = False            # a slave's record: what it hands its master when fetched (seed 3.2.2)
     reply_to: str | None = None     # the request this message answers (seed 3.2.2: a reply within the response timeout)
     carried_in: str | None = None   # sent as a code inside that message's field, never as a frame of its own
+    record_values: tuple[str, ...] = ()   # the fields a record's value byte carries (seed 3.2.2, 6.2)
+    record_channel: str | None = None     # the field whose value is a record's channel (else: position in record_values)
 
     @property
     def fixed_size(self) -> int:
@@ -527,7 +530,7 @@ def _fields(raw_fields: list[dict], enums: dict[str, Enum], flags: dict[str, Fla
             enum=enums.get(f.get("enum", "")), flags=flags.get(f.get("flags", "")),
             unit=f.get("unit", ""), encoding=encoding, range=rng,  # type: ignore[arg-type]
             count=f.get("count"), count_max=count_max,
-            origin=f.get("origin", "seed"), doc=f.get("doc", ""),
+            origin=f.get("origin", "seed"), doc=f.get("doc", ""), compared_with=f.get("compared_with"),
         ))
         if "count" not in f:
             offset += bits
@@ -592,7 +595,8 @@ def build(nodes_doc: dict, messages_doc: dict, sources: tuple[Path, ...], digest
                 senders=tuple(m["from"]), receivers=tuple(m["to"]), doc=m["doc"],
                 fields=_fields(m.get("fields", []), enums, flags, fdoc["max_payload"]), relayed_as=m.get("relayed_as"),
                 record=bool(m.get("record", False)), reply_to=m.get("reply_to"),
-                carried_in=m.get("carried_in"))
+                carried_in=m.get("carried_in"), record_values=tuple(m.get("record_values", ())),
+                record_channel=m.get("record_channel"))
         for m in messages_doc["messages"]
     )
     p = nodes_doc["protocol"]

@@ -8,11 +8,11 @@
 #include "role_config.h"
 #include "hal.h"
 
-static uint8_t rx_buf[FW_RX_MAX];      /* the parser's frame buffer (ISR side) */
 static uint8_t frame_buf[FW_RX_MAX];   /* a checked frame waiting for dispatch (main side) */
 static volatile uint8_t frame_ready;   /* a byte: read atomically on an 8-bit core */
-/* initialised at build time: the role's own address and payload check are constants (no init code, issue 15) */
-static arachnae_parser parser = ARACHNAE_PARSER_INIT(rx_buf, FW_RX_MAX, FW_OWN_ADDRESS, FW_ROLE_CHECK);
+/* the role's parser (ISR side; its buffer holds the role's largest frame): initialised at build time, its
+ * address, buffer size and payload check built in by the generator (no init code, issue 15) */
+static FW_ROLE_RX parser = FW_ROLE_RX_INIT(FW_OWN_ADDRESS);
 static FW_ROLE_NODE node;
 
 /* Counters a debugger or a test can read. fw_rx_errors: frames the parser refused (envelope, OPCODE, LENGTH,
@@ -27,7 +27,7 @@ volatile uint16_t fw_rx_corrupt_ms, fw_rx_pause_chars;
  * byte), not a corrupt one: counting it as a collision would keep every slave's backoff window open. */
 static uint8_t too_long(void)
 {
-    return (uint8_t)((uint16_t)(ARACHNAE_FRAME_OVERHEAD + rx_buf[ARACHNAE_FRAME_LENGTH]) > FW_RX_MAX);
+    return (uint8_t)((uint16_t)(ARACHNAE_FRAME_OVERHEAD + parser.buf[ARACHNAE_FRAME_LENGTH]) > FW_RX_MAX);
 }
 
 /* Interrupt context: a frame heard whole (st: the parser's verdict) that ended `ago_ms` before now. */
@@ -41,9 +41,9 @@ static void heard(arachnae_status st, uint16_t ago_ms)
     }
     /* the envelope is intact (the parser checks CRC before address and payload), or too long for us to
        check (too_long): its source and length are taken as they came */
-    fw_rx_from_master = (uint8_t)(rx_buf[ARACHNAE_FRAME_SRC] == FW_MASTER_ADDRESS);
-    if (rx_buf[ARACHNAE_FRAME_OPCODE] != FW_REQUEST_OPCODE)
-        fw_rx_pause_chars = (uint16_t)(fw_rx_pause_chars + ARACHNAE_FRAME_OVERHEAD + rx_buf[ARACHNAE_FRAME_LENGTH]);
+    fw_rx_from_master = (uint8_t)(parser.buf[ARACHNAE_FRAME_SRC] == FW_MASTER_ADDRESS);
+    if (parser.buf[ARACHNAE_FRAME_OPCODE] != FW_REQUEST_OPCODE)
+        fw_rx_pause_chars = (uint16_t)(fw_rx_pause_chars + ARACHNAE_FRAME_OVERHEAD + parser.buf[ARACHNAE_FRAME_LENGTH]);
 }
 
 static void count_error(arachnae_status st, uint16_t ago_ms)
@@ -57,7 +57,7 @@ void fw_rx_byte(uint8_t byte)
 {
     uint16_t n = 0, i;
     const uint8_t *f;
-    arachnae_status st = arachnae_parser_feed(&parser, byte);
+    arachnae_status st = FW_ROLE_RX_FEED(&parser, byte);
     if (st == ARACHNAE_NONE)
         return;
     if (st != ARACHNAE_OK) {
@@ -69,7 +69,7 @@ void fw_rx_byte(uint8_t byte)
         fw_rx_overruns++;
         return;
     }
-    f = arachnae_parser_frame(&parser, &n);
+    f = FW_ROLE_RX_FRAME(&parser, &n);
     for (i = 0; i < n; i++)
         frame_buf[i] = f[i];
     fw_rx_frames++;
@@ -79,7 +79,7 @@ void fw_rx_byte(uint8_t byte)
 /* Timer interrupt context: the line was idle for FW_IDLE_GAP_US. */
 void fw_rx_gap(void)
 {
-    arachnae_status st = arachnae_parser_gap(&parser);
+    arachnae_status st = FW_ROLE_RX_GAP(&parser);
     if (st != ARACHNAE_NONE)
         count_error(st, (uint16_t)(FW_IDLE_GAP_US / 1000UL));  /* a frame cut short (TRUNCATED), a gap ago */
 }

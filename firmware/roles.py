@@ -94,7 +94,11 @@ def role_config(spec, role: str) -> str:
         f'#include "node_{low}.h"',
         f"#define FW_ROLE_NODE {low}_node",
         f"#define FW_ROLE_INIT {low}_node_init",
-        f"#define FW_ROLE_CHECK {low}_payload_check",
+        f"#define FW_ROLE_RX {low}_rx",
+        f"#define FW_ROLE_RX_INIT {role.upper()}_RX_INIT",
+        f"#define FW_ROLE_RX_FEED {low}_rx_feed",
+        f"#define FW_ROLE_RX_GAP {low}_rx_gap",
+        f"#define FW_ROLE_RX_FRAME {low}_rx_frame",
         f"#define FW_ROLE_DISPATCH {low}_dispatch",
         f"#define FW_RX_MAX ARACHNAE_RX_MAX_{role}",
         "#endif",
@@ -133,27 +137,22 @@ def slave_timing(net, node, t, rank: int) -> list[str]:
     ]
 
 
-# a sensor's SET_ALARM limit and the data field it is compared with (behaviours/sensors.py)
-ALARM_FIELDS = {"IRRC": ("SetAlarmIrrc", "XmitDataIrrc", "center"), "ISC": ("SetAlarmIsc", "XmitDataIsc", "longitudinal"),
-                "TSC": ("SetAlarmTsc", "XmitDataTsc", "temperature"), "LSC": ("SetAlarmLsc", "XmitDataLsc", "brightness"),
-                "PSC": ("SetAlarmPsc", "XmitDataPsc", "voltage")}
-
-
 def alarm_limit(role: str) -> list[str]:
     """Whether the SET_ALARM limit's raw value IS the data field's raw value (behaviours.sensors.limit_in is the
     identity over the limit's whole raw range): then the firmware compares it as it comes, without linking the
     physical conversions (LSC: a log table); else it converts through the generated _to_milli/_from_milli."""
-    if role not in ALARM_FIELDS:
-        return []
     from arachnae_proto import messages as M
+    if role not in M.ALARM_THRESHOLDS:
+        return []
     from behaviours.sensors import limit_in
-    from behaviours.units import quantizer
-    alarm, data, field = ALARM_FIELDS[role]
-    info = next(f for f in getattr(M, alarm).FIELDS if f.name == "limit")
+    from behaviours.units import values_quantizer
+    a = M.ALARM_THRESHOLDS[role]           # the spec's threshold and the record values it is compared with
+    info = next(f for f in a.message.FIELDS if f.name == a.limit)
     lo, hi = info.conv.lo, info.conv.hi
-    same = all(limit_in(quantizer(getattr(M, data), field), getattr(M, alarm), r) == r for r in range(lo, hi + 1))
-    return [f"/* SET_ALARM limit raw {lo}..{hi} equals the {field} raw value for every value (checked by roles.py) */",
-            f"#define FW_ALARM_LIMIT_IS_DATA_RAW {1 if same else 0}"]
+    data = values_quantizer(a.data)
+    same = all(limit_in(data, a.message, r) == r for r in range(lo, hi + 1))
+    return [f"/* {a.message.NAME}.{a.limit} raw {lo}..{hi} equals the {'/'.join(a.data.fields)} raw value for every "
+            f"value (checked by roles.py) */", f"#define FW_ALARM_LIMIT_IS_DATA_RAW {1 if same else 0}"]
 
 
 def tuning(role: str) -> list[str]:
@@ -176,7 +175,7 @@ def tuning(role: str) -> list[str]:
     return out
 
 
-_PROTO = re.compile(r"^(void|arachnae_status)\s+(\w+)\((.*)\);$")
+_PROTO = re.compile(r"^(void|arachnae_status|uint8_t)\s+(\w+)\((.*)\);$")
 
 
 def stub_source(role: str) -> str:
@@ -193,20 +192,27 @@ def stub_source(role: str) -> str:
         ret, name, args = m.groups()
         params = [a.strip().split()[-1].lstrip("*") for a in args.split(",") if a.strip() and a.strip() != "void"]
         body = "".join(f" (void){p};" for p in params)
-        if ret != "void":
+        if ret == "arachnae_status":
             body += " return ARACHNAE_OK;"
+        elif ret == "uint8_t":
+            body += " return 0;"   # a request's callback: no reply now
         out.append(f"{ret} {name}({args}) {{{body} }}")
     return "\n".join(out) + "\n"
 
 
 def fuzz_roles(spec) -> str:
-    out = ["/* Every role's payload check and dispatch (built by firmware/roles.py fuzzroles). */"]
+    out = ["/* Every role's payload check, dispatch and parser (built by firmware/roles.py fuzzroles). */",
+           "#include <string.h>"]
     out += [f'#include "node_{r.lower()}.h"' for r in spec.roles]
     out += ["", "typedef struct {", "    const char *name;",
             "    arachnae_payload_check_fn check;",
             "    /* NONE if `own` is not an address of the role, else the dispatch status of a frame the",
             "     * role's parser passed (dispatch takes only those: it does not check again, issue 15), OK for NULL */",
             "    arachnae_status (*dispatch)(uint8_t own, const uint8_t *frame);",
+            "    uint16_t rx_max;   /* the role parser's buffer: ARACHNAE_RX_MAX_<role> */",
+            "    /* the role's own parser (<role>_rx_feed/_gap) over one burst: its verdict as fuzz_frame.c's",
+            "     * parse_burst gives it; an OK frame is copied to `out` (rx_max bytes), its length to *out_len */",
+            "    arachnae_status (*rx)(uint8_t own, const uint8_t *data, uint16_t len, uint8_t *out, uint16_t *out_len);",
             "} fz_role;", ""]
     for r in spec.roles:
         low = r.lower()
@@ -216,9 +222,29 @@ def fuzz_roles(spec) -> str:
                 "        return ARACHNAE_NONE;",
                 "    if (frame == 0)",
                 "        return ARACHNAE_OK;   /* only asked whether own is an address of the role */",
-                f"    return {low}_dispatch(&node, frame);", "}", ""]
+                f"    return {low}_dispatch(&node, frame);", "}", "",
+                f"static arachnae_status fz_rx_{low}(uint8_t own, const uint8_t *data, uint16_t len, uint8_t *out, uint16_t *out_len)",
+                "{",
+                f"    {low}_rx p = {r.upper()}_RX_INIT(own);",
+                "    arachnae_status verdict = ARACHNAE_NONE, st;",
+                "    const uint8_t *f;",
+                "    uint16_t i;",
+                "    (void)own;",
+                "    for (i = 0; i < len; i++)",
+                f"        if ((st = {low}_rx_feed(&p, data[i])) != ARACHNAE_NONE)",
+                "            verdict = st;",
+                f"    st = {low}_rx_gap(&p);",
+                "    if (verdict == ARACHNAE_NONE)",
+                "        verdict = st;",
+                f"    f = {low}_rx_frame(&p, out_len);",
+                "    if ((verdict == ARACHNAE_OK) != (f != 0))",
+                "        return ARACHNAE_NONE;   /* frame() disagrees with the verdict: never a parser's answer */",
+                "    if (f != 0)",
+                "        memcpy(out, f, *out_len);",
+                "    return verdict;", "}", ""]
     out += [f"static const fz_role fz_roles[{len(spec.roles)}] = {{"]
-    out += [f'    {{"{r}", {r.lower()}_payload_check, fz_dispatch_{r.lower()}}},' for r in spec.roles]
+    out += [f'    {{"{r}", {r.lower()}_payload_check, fz_dispatch_{r.lower()}, ARACHNAE_RX_MAX_{r.upper()}, fz_rx_{r.lower()}}},'
+            for r in spec.roles]
     out += ["};", ""]
     return "\n".join(out)
 

@@ -40,7 +40,9 @@ from pathlib import Path
 from typing import Any, Callable, NamedTuple
 
 
+from arachnae_proto import frame as proto_frame, messages as proto_messages
 from arachnae_proto.enums import RangeStatus
+from codegen.load import load_spec
 
 FIRMWARE = Path(__file__).resolve().parent
 BUILD = FIRMWARE / "build"
@@ -386,11 +388,8 @@ class SilNode:
 @lru_cache(maxsize=None)
 def _quantizers() -> dict[str, Any]:
     """The sensors' field conversions (behaviours.units), the front end's transfer functions."""
-    from arachnae_proto import messages as M
-    from behaviours.units import quantizer
-    return {"us": quantizer(M.XmitDataUsrc, "distance"), "ir": quantizer(M.XmitDataIrrc, "center"),
-            "isc": quantizer(M.XmitDataIsc, "longitudinal"), "tsc": quantizer(M.XmitDataTsc, "temperature"),
-            "lsc": quantizer(M.XmitDataLsc, "brightness"), "psc": quantizer(M.XmitDataPsc, "voltage")}
+    from behaviours.units import RECORD_QUANTIZER as Q          # the spec's record_values of each sensor
+    return {"us": Q["USRC"], "ir": Q["IRRC"], "isc": Q["ISC"], "tsc": Q["TSC"], "lsc": Q["LSC"], "psc": Q["PSC"]}
 
 
 def sil_factory(elf: Path | str | None = None, made: list[SilNode] | None = None) -> Callable[..., SilNode]:
@@ -423,6 +422,43 @@ RAM_BYTES = 2048          # ATmega328P SRAM (the SIL target, avr/hal_avr.c)
 def ram_use(nodes: list[SilNode]) -> list[RamUse]:
     """Per SIL node, at the end of a run (its simavr process must still be running)."""
     return [RamUse(n.node.short, static_ram(n.elf), n.host.stack_used(), RAM_BYTES) for n in nodes]
+
+
+PROBE_GAP_MS = 50         # between two requests of the RAM probe: the reply and the idle gap fit in it
+
+
+def ram_probe(elf: Path, role: str) -> RamUse:
+    """simavr's RAM high-water mark of one role's firmware on its own (`make size`, issue 15 item 4): start-up,
+    then every request without fields the role takes from its bus master (INIT, ID_REQ, STATUS_REQ, XMIT_DATA ...),
+    each answered, and a whisker contact (the TPSC's DATA_RDY path; other roles leave those inputs alone), one every
+    PROBE_GAP_MS; a few hundred simulated milliseconds. The figure is the deepest stack seen plus static RAM: what
+    this run reached, a lower bound beside the static call-graph figure of size_report.py."""
+    spec = load_spec()
+    node = spec.role_nodes(role.upper())[0]
+    bus = spec.buses[node.bus]
+    master = spec.node(bus.master)
+    char = F_CPU * bus.bits_per_char // bus.baud
+    gap = F_CPU // 1000 * PROBE_GAP_MS
+    requests = [proto_frame.build(node.address, master.address, proto_messages.BY_NAME[m.name]())
+                for m in spec.receives(role.upper()) if not m.fields and master.role in m.senders]
+    host = SilHost(elf)
+    try:
+        for pin in INPUT_PINS:
+            host.set_pin(pin, 1)            # switches open (active low)
+        host.set_pin(CD_PIN, 0)
+        host.run_until(gap)
+        for data in requests:
+            start = host.cycle
+            for i, b in enumerate(data):
+                host.inject(start + i * char, b)
+            host.run_until(start + gap)
+        host.set_pin(INPUT_PINS[0], 0)      # a contact on the first input
+        host.run_until(host.cycle + gap)
+        host.set_pin(INPUT_PINS[0], 1)
+        host.run_until(host.cycle + gap)
+        return RamUse(role, static_ram(Path(elf)), host.stack_used(), RAM_BYTES)
+    finally:
+        host.close()
 
 
 def ram_lines(uses: list[RamUse]) -> list[str]:

@@ -7,8 +7,8 @@ they count only what --gc-sections kept, split by where it came from:
     firmware   main.c, the board HAL and the behaviour (or an empty stub)
     runtime    C start-up, libgcc, libc, vector table
 Stack: worst case over the static call graph (objdump calls + -fstack-usage frames, plus
-the return address each call pushes), deepest path first; the parser's one indirect call is
-resolved to the role's payload check. parse = the RX interrupt's parser path, dispatch = the
+the return address each call pushes), deepest path first; the generic parser's one indirect call
+is resolved to the role's payload check. parse = the RX interrupt's parser path (<role>_rx_feed), dispatch = the
 skeleton without the behaviour, node = main with all it calls plus the deepest interrupt.
 Issue 15: the budgets (a sensor role in 1 KiB, any role in 2 KiB, the TPSC within 1.5x of the
 hand-written baseline) and, with --nanopb, nanopb's codec bytes for the same roles beside ours.
@@ -27,10 +27,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent))
+from firmware.sil_bridge import PROBE_GAP_MS, SilError, ram_probe  # noqa: E402  (run as a script from firmware/)
+
 SENSOR_ROLES = ("usrc", "tpsc", "irrc", "isc", "tsc", "lsc", "psc")
 AVR_FLASH_BUDGET = 2048          # issue 6: codec + skeleton of any role in 2 KiB of AVR flash
 SENSOR_FLASH_BUDGET = 1024       # issue 15: a sensor role's codec + skeleton in 1 KiB
-TPSC_BASELINE_RATIO = 1.5        # issue 15: the TPSC within 1.5x of the hand-written baseline
+BASELINE_RATIO = 1.5             # issue 15: a role within 1.5x of its hand-written baseline
 TOOLS = {"avr": ("avr-objdump", 2), "m0": ("arm-none-eabi-objdump", 0)}   # objdump, bytes a call pushes
 
 FLASH_SECTIONS = (".text", ".rodata", ".progmem", ".isr_vector", ".vectors", ".init", ".fini", ".trampolines", ".ctors", ".dtors", ".jumptables")
@@ -58,6 +61,7 @@ class Image:
     stack: dict[str, int] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
     messages: Part = field(default_factory=Part)     # the codec's msg_*.o only (per-message code)
+    sim_ram: int | None = None    # simavr high-water mark (static + deepest stack seen), --sil-ram roles only
 
     @property
     def total(self) -> Part:
@@ -209,7 +213,9 @@ def analyse_stack(build: Path, image: Image, elf: Path) -> None:
         image.stack["dispatch"] = worst("fw_dispatch", calls, indirect, frame, {}, push, {"hal_send"}, notes)
     else:
         # decoding a frame: the RX interrupt's parser path, and the dispatch without the behaviour
-        image.stack["parse"] = worst("arachnae_parser_feed", calls, indirect, frame, resolve, push, set(), notes)
+        if f"{role}_rx_feed" not in calls:     # the role's own parser (node_<role>.c) must be the one linked
+            notes.append(f"unresolved parser: no {role}_rx_feed in the image")
+        image.stack["parse"] = worst(f"{role}_rx_feed", calls, indirect, frame, resolve, push, set(), notes)
         image.stack["dispatch"] = worst(f"{role}_dispatch", calls, indirect, frame, resolve, push, behaviour, notes)
     # the whole node: main with everything it calls, plus the deepest interrupt on top of it
     isrs = [f for f in calls if f.startswith("__vector_") or f.endswith("_Handler") or f.endswith("IRQHandler")]
@@ -242,7 +248,7 @@ def load_images(build: Path, baselines: list[str]) -> list[Image]:
 def table(images: list[Image], target: str) -> list[str]:
     head = (f"{'role':14} {'codec t/d/b':>14} {'skeleton t/d/b':>15} {'codec+skel':>10} "
             f"{'firmware t/b':>13} {'image flash':>11} {'static RAM':>10} {'stack parse/dispatch/node':>26} "
-            f"{'RAM+stack':>9}")
+            f"{'RAM+stack':>9}" + (f" {'simavr RAM':>10}" if target == "avr" else ""))
     rows = [head, "-" * len(head)]
     for img in images:
         if img.target != target:
@@ -251,8 +257,22 @@ def table(images: list[Image], target: str) -> list[str]:
         stack = f"{img.stack.get('parse', 0)}/{img.stack.get('dispatch', 0)}/{img.stack.get('node', 0)}"
         rows.append(f"{img.role:14} {f'{c.text}/{c.data}/{c.bss}':>14} {f'{s.text}/{s.data}/{s.bss}':>15} "
                     f"{c.flash + s.flash:>10} {f'{f.text}/{f.bss}':>13} {t.flash:>11} {t.data + t.bss:>10} "
-                    f"{stack:>26} {t.data + t.bss + img.stack.get('node', 0):>9}")
+                    f"{stack:>26} {t.data + t.bss + img.stack.get('node', 0):>9}"
+                    + (f" {img.sim_ram if img.sim_ram is not None else '-':>10}" if target == "avr" else ""))
     return rows
+
+
+def sim_ram(build: Path, images: list[Image], roles: list[str]) -> None:
+    """The simavr RAM high-water mark of each listed role's AVR image (issue 15 item 4)."""
+    if not roles:
+        return
+    for img in images:
+        if img.target == "avr" and img.role in roles:
+            try:
+                use = ram_probe(build / "avr" / f"{img.role}.elf", img.role)
+            except SilError as exc:
+                raise SystemExit(f"size_report: simavr run of {img.role}: {exc}") from None
+            img.sim_ram = use.static + use.stack
 
 
 def load_nanopb(build: Path, roles: list[str]) -> list[Image]:
@@ -306,8 +326,13 @@ def comparison(images: list[Image], nanopb: list[Image]) -> list[str]:
         nratio = f"{n / ours:.2f}x" if n else "-"
         out.append(f"{img.role:8} {ours:>15} {img.messages.flash:>12} {b if b else '-':>9} {ratio:>13} "
                    f"{n if n else '-':>12} {nratio:>11}")
-    if "tpsc" in baselines:
-        out.append(f"  TPSC bar: ours <= {TPSC_BASELINE_RATIO} x baseline = {int(TPSC_BASELINE_RATIO * baselines['tpsc'])} bytes")
+    for role, base in baselines.items():
+        ours = next((codec_skel(i) for i in images if i.target == "avr" and i.role == role), None)
+        if ours is None:
+            continue
+        bar = int(BASELINE_RATIO * base)
+        out.append(f"  {role} bar: ours <= {BASELINE_RATIO} x baseline = {bar} bytes: "
+                   + ("met" if ours <= bar else f"NOT met, over by {ours - bar}"))
     for role, base in base_images.items():
         gen = next(i for i in images if i.target == "avr" and i.role == role)
         out.append(f"  {role} images: generated {gen.total.flash} bytes flash, {gen.total.data + gen.total.bss} static RAM; "
@@ -321,9 +346,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--build", default=str(HERE / "build"), help="firmware build folder")
     ap.add_argument("--nanopb", default="", help="roles with a nanopb build to compare with (space separated)")
     ap.add_argument("--baselines", default="tpsc", help="roles with a hand-written baseline image (space separated)")
+    ap.add_argument("--sil-ram", default="", help="roles whose AVR image runs in simavr for its RAM high-water mark "
+                                                    "(space separated; needs `make -C firmware sil`)")
     args = ap.parse_args(argv)
     build = Path(args.build)
     images = load_images(build, args.baselines.split())
+    sim_ram(build, images, args.sil_ram.split())
     nanopb = load_nanopb(build, args.nanopb.split())
     failures: list[str] = []
     out: list[str] = []
@@ -333,6 +361,10 @@ def main(argv: list[str] | None = None) -> int:
                 f" behaviour, node = main + deepest ISR; RAM+stack = static RAM + node stack, the RAM the role needs"
                 f" at most{', of 2048 on an ATmega328P' if target == 'avr' else ''})"]
         out += table(images, target)
+    if args.sil_ram:
+        out.append(f"  simavr RAM = static RAM + the deepest stack of a simavr run (start-up, each request without fields"
+                   f" from the master, a contact on the first input, one every {PROBE_GAP_MS} ms; firmware/sil_bridge.py"
+                   " ram_probe): what that run reached, beside the static worst case RAM+stack")
     out += budgets(images, failures)
     out += comparison(images, nanopb)
     for img in images:
@@ -343,6 +375,7 @@ def main(argv: list[str] | None = None) -> int:
     print("\n".join(out))
     (build / "size.json").write_text(json.dumps(
         [{"role": i.role, "target": i.target, "stack": i.stack, "notes": i.notes, "messages": vars(i.messages),
+          "sim_ram": i.sim_ram,
           **{k: vars(p) for k, p in i.parts.items()}} for i in images]
         + [{"role": i.role, "target": "avr-nanopb", "codec": vars(i.parts["codec"])} for i in nanopb], indent=1) + "\n")
     for f in failures:

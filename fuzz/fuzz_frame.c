@@ -12,6 +12,9 @@
  *   3. the receiving role's skeleton (dispatch and its parser with the role's
  *      payload check) agrees with the whole-frame verdict, OPCODE for a message the
  *      role does not receive;
+ *   3b. the role's own parser (node_<role>.c, built with the role's buffer size, address and check) gives
+ *      the verdict, and passes the frame, that the generic parser gives with the same buffer size, own
+ *      address and check (the two are one template, codegen/templates/c/parser.j2);
  *   4. a decoder given a payload of the claimed length reads nothing beyond it
  *      (the payload is copied to a heap block of exactly that size).
  * Every input is checked twice: as it is, and with its last two bytes replaced by
@@ -38,12 +41,12 @@ static void fail(const char *what, int a, int b)
  * OVERSIZE supersedes an earlier OK), else what the gap reports. With `passed`: the frame the
  * parser holds after an OK verdict (in buf, ARACHNAE_MAX_FRAME bytes), else NULL. */
 static arachnae_status parse_burst(const uint8_t *data, uint16_t len, uint16_t own, arachnae_payload_check_fn check,
-                                   uint8_t *buf, const uint8_t **passed)
+                                   uint8_t *buf, uint16_t cap, const uint8_t **passed)
 {
     arachnae_parser p;
     arachnae_status verdict = ARACHNAE_NONE, st;
     uint16_t i, flen = 0;
-    arachnae_parser_init(&p, buf, ARACHNAE_MAX_FRAME, own, check);
+    arachnae_parser_init(&p, buf, cap, own, check);
     for (i = 0; i < len; i++) {
         st = arachnae_parser_feed(&p, data[i]);
         if (st != ARACHNAE_NONE)
@@ -72,7 +75,7 @@ static void check_frame(uint8_t own, const uint8_t *frame, uint16_t len)
     memset(&m, 0xA5, sizeof m);
     whole = arachnae_frame_decode(frame, len, own, &h, &m);
     if (len > 0u) {
-        parsed = parse_burst(frame, len, own, arachnae_payload_check, pbuf, NULL);
+        parsed = parse_burst(frame, len, own, arachnae_payload_check, pbuf, ARACHNAE_MAX_FRAME, NULL);
         if (parsed != whole)
             fail("byte parser and whole-frame check disagree", (int)parsed, (int)whole);
     }
@@ -102,9 +105,21 @@ static void check_frame(uint8_t own, const uint8_t *frame, uint16_t len)
             expect = ARACHNAE_OPCODE;
         if (len == 0u)
             continue;
-        role_parsed = parse_burst(frame, len, own, fz_roles[r].check, pbuf, &passed);
+        role_parsed = parse_burst(frame, len, own, fz_roles[r].check, pbuf, ARACHNAE_MAX_FRAME, &passed);
         if (role_parsed != expect)
             fail(fz_roles[r].name, (int)role_parsed, (int)expect);
+        {
+            /* 3b. the role's own parser against the generic one with the role's buffer size */
+            uint8_t gbuf[ARACHNAE_MAX_FRAME], rbuf[ARACHNAE_MAX_FRAME];
+            const uint8_t *gpassed = NULL;
+            uint16_t rlen = 0;
+            arachnae_status generic = parse_burst(frame, len, own, fz_roles[r].check, gbuf, fz_roles[r].rx_max, &gpassed);
+            arachnae_status own_rx = fz_roles[r].rx(own, frame, len, rbuf, &rlen);
+            if (own_rx != generic)
+                fail("the role's parser and the generic parser disagree", (int)own_rx, (int)generic);
+            if (gpassed != NULL && (rlen != len || memcmp(rbuf, frame, len) != 0))
+                fail("the role's parser passed other bytes", (int)rlen, (int)len);
+        }
         if (passed == NULL)
             continue;
         disp = fz_roles[r].dispatch(own, passed);

@@ -143,11 +143,8 @@ def run_check(args) -> int:
         elif getattr(args, "hash_compact", None):
             from model_check.bitstate import explore_hash_compact
             res, _ = explore_hash_compact(model, args.hash_compact, progress=not args.quiet)
-        elif getattr(args, "workers", 1) > 1:
-            from model_check.parallel import explore_parallel
-            res = explore_parallel(model, args.workers, progress=not args.quiet)
         else:   # compiled up front, every model (as SPIN compiles pan.c); the compile is timed apart
-            res = explore(model, progress=not args.quiet, use_native=True)
+            res = explore(model, progress=not args.quiet, use_native=True, workers=getattr(args, "workers", 1))
         ok &= res.ok and meets_deadline(res)
         results.append(res)
         res.release()              # the graph is no longer needed: keep memory flat over `check all`

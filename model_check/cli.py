@@ -28,8 +28,8 @@ def register(sub) -> None:
     c.add_argument("--json", action="store_true", help="print the results as JSON")
     c.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     c.add_argument("--workers", type=_positive, default=1, metavar="N",
-                   help="search on N processes with a partitioned visited set (safety only: invariants, "
-                        "deadlocks, coverage; the same counts and verdicts as one process)")
+                   help="search on N threads sharing the visited set (every property checked; the same "
+                        "states, ids, edges and verdicts as one thread)")
     c.add_argument("--bitstate", type=_bits, default=None, metavar="BITS",
                    help="bitstate search in 2^BITS bits of memory (%d..%d), safety only; prints the expected "
                         "omissions: a pass is then NOT a proof" % (BITSTATE_MIN, BITSTATE_MAX))

@@ -17,6 +17,7 @@ from typing import TextIO
 
 import numpy as np
 
+from model_check import parallel
 from model_check.compile import Compiled, RangeError, compile_model
 from model_check.gcl import Model
 from model_check.liveness import check_responses
@@ -50,6 +51,7 @@ class Result:
     cpu: float = 0.0                           # CPU seconds of the whole check (search and properties)
     proof: bool = True                         # False after a bitstate search: a pass proves nothing
     native: Native | None = None               # the compiled model the search ended on (None: Python)
+    rounds: parallel.Rounds | None = None      # what the threads did (--workers > 1)
 
     @property
     def ok(self) -> bool:
@@ -118,9 +120,11 @@ class Progress:
 
 
 def explore(model: Model, compiled: Compiled | None = None, progress: bool = True,
-            check_liveness: bool = True, use_native: bool | None = None) -> Result:
+            check_liveness: bool = True, use_native: bool | None = None, workers: int = 1) -> Result:
     """Explore every reachable state; stop at the first safety violation. `use_native`: True
-    compiles the model for C at once, False never, None from NATIVE_AFTER states (see _search)."""
+    compiles the model for C at once, False never, None from NATIVE_AFTER states (see _search).
+    `workers` > 1: the compiled search on that many threads (model_check.parallel: the same
+    store, so the same result); without a compiled model the search stays on one thread."""
     comp = compiled or compile_model(model)
     res = Result(model=model, compiled=comp, coverage=[0] * len(model.rules))
     if model.symmetry and model.responses and check_liveness:
@@ -137,7 +141,12 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
     store = StateStore(comp.layout.total_bits, len(model.rules))
     store.add_initial(comp.init)
     res.layer_starts = [0, 1]
-    hit, hit_id, res.native = _search(model, comp, store, res.layer_starts, bar, res.times, use_native)
+    res.rounds = parallel.Rounds() if workers > 1 else None
+    hit, hit_id, res.native = _search(model, comp, store, res.layer_starts, bar, res.times, use_native, workers,
+                                      res.rounds)
+    if workers > 1 and res.native is None:
+        res.warnings.append(f"--workers {workers}: no compiled model (no C compiler, or a construct the C "
+                            "generator does not translate): searched on one thread")
     res.store_bytes = store.nbytes         # before finish drops the hash table: the search's peak
     store.finish()
     res.store = store
@@ -167,7 +176,8 @@ def explore(model: Model, compiled: Compiled | None = None, progress: bool = Tru
 
 
 def _search(model: Model, comp: Compiled, store: StateStore, layer_starts: list[int], bar: Progress | None,
-            times: dict[str, float], use_native: bool | None) -> tuple[tuple | None, int, Native | None]:
+            times: dict[str, float], use_native: bool | None, workers: int = 1,
+            rounds: parallel.Rounds | None = None) -> tuple[tuple | None, int, Native | None]:
     """Breadth-first layers; (hit, id of the hit state, the compiled model used or None), hit None
     and id -1 when there is none.
 
@@ -187,6 +197,10 @@ def _search(model: Model, comp: Compiled, store: StateStore, layer_starts: list[
             times["compile"] = times.get("compile", 0.0) + _cpu() - before
             # explore takes this off the search
             times["compile, in process"] = times.get("compile, in process", 0.0) + time.process_time() - own
+        if nat is not None and rounds is not None:
+            return (*parallel.search(model, store, lo, nat, workers,
+                                     lambda first, width: _next_layer(store, layer_starts, bar, first, width),
+                                     rounds), nat)
         if nat is not None:           # breadth-first order is id order: the layer is ids lo .. len-1
             return (*_search_native(model, store, lo, nat, layer_starts, bar), nat)
         hi = len(store)

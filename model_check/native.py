@@ -125,6 +125,18 @@ static inline I pmod(I a, I b) { I r = a % b; return (r != 0 && ((r < 0) != (b <
 """
 
 
+# Stored rows are KW bytes (storage.StateStore), KW known when the C is generated: compared as
+# 8-byte words (the last one overlapping the one before), no memcmp call (13% of a profile).
+_KEQ = """\
+static inline int keq(const uint8_t *a, const uint8_t *b) {
+    U x, y;
+    if (KW < 8) { x = y = 0; memcpy(&x, a, KW); memcpy(&y, b, KW); return x == y; }
+    for (int o = 0; o + 8 < KW; o += 8) { memcpy(&x, a + o, 8); memcpy(&y, b + o, 8); if (x != y) return 0; }
+    memcpy(&x, a + KW - 8, 8); memcpy(&y, b + KW - 8, 8);
+    return x == y;
+}"""
+
+
 def predicate_texts(model: Model) -> list[str]:
     """The predicates the C code evaluates over stored states: `final`, then each response's
     trigger and goal (index 1 + 2k and 2 + 2k)."""
@@ -228,12 +240,253 @@ out:
 """ % {"bound": L_BOUND, "overflow": L_OVERFLOW, "violation": L_VIOLATION, "fair": L_FAIR_ONLY}
 
 
+# The parallel search (model_check.parallel): `prun`, called on every thread at once (thread t),
+# runs rounds over `bfs`'s hash table and rows until the search ends, a hit, `rounds` rounds, or
+# arrays to grow; threads meet at barriers in C (no Python between the steps). A round: thread 0
+# cuts the next states into consecutive slices (several per thread); then, the threads taking
+# the slices as they come free (ptake), each slice
+# - is expanded against the table as it is, read only; a successor not in it becomes a
+#   candidate, deduplicated in the slice's own table, with its hash and where its probe of the
+#   shared table stopped (slot, step);
+# - (kept if every slice before it finished) has its candidates marked: one an earlier slice has too is
+#   that slice's (the earliest), the others are new, numbered in first-seen order;
+# - (thread 0: each slice's base id is the stored states plus the new ones of the slices before)
+#   writes each new candidate's row and parent at base + number and claims a table slot for its
+#   id with a compare-and-swap from where its probe stopped (the slots before it stay taken), and
+#   its edges, each candidate turned into its id, at their place in the store.
+_PARALLEL = """\
+#include <sched.h>
+typedef struct {
+    int32_t *ev; RULE_T *er; uint8_t *crow; int32_t *cpar; U *chash; int64_t *cslot, *cstep;
+    int32_t *clocal, *ltable, *cown, *cidx;
+    int64_t lbits, a, b, edge0, fresh, base, kept;
+    Res r;
+} Slice;
+typedef struct {
+    uint8_t *keys; int32_t *parent, *table, *dst; RULE_T *rules; uint16_t *degree;
+    int64_t width, tbits, tlimit, kcap, ecap, dcap, nk, ne, i, workers, edges_max, narrow, fan,
+            seen_states, seen_edges, rounds, status, cap, bcount, bsense, nrounds, nsplit, ndropped,
+            nslices, cexp, cmark, cins;
+    Res hit;
+} Ctx;
+enum { P_RUN, P_DONE, P_PAUSE, P_GROW, P_HIT };
+static void pbarrier(Ctx *c, int64_t *sense) {
+    int64_t s = !*sense;
+    *sense = s;
+    if (__atomic_add_fetch(&c->bcount, 1, __ATOMIC_ACQ_REL) == c->workers) {
+        __atomic_store_n(&c->bcount, 0, __ATOMIC_RELAXED);
+        __atomic_store_n(&c->bsense, s, __ATOMIC_RELEASE);
+    } else
+        for (int k = 0; __atomic_load_n(&c->bsense, __ATOMIC_ACQUIRE) != s; k++)
+            if (k > 100) sched_yield();
+}
+static void pexpand(const Ctx *c, Slice *q) {
+    int64_t tbits = c->tbits;
+    U tmask = ((U)1 << tbits) - 1, lmask = ((U)1 << q->lbits) - 1, s[W];
+    U succ[NRULES * W]; int32_t sr[NRULES];
+    uint8_t tb[W * 8];
+    const uint8_t *keys = c->keys;
+    int64_t ne = 0, nc = 0, i = q->a;
+    Res *r = &q->r;
+    r->kind = 0;
+    for (; i < q->b; i++) {
+        if (ne + NRULES > c->cap) { r->kind = HIT_FULL; break; }
+        memset(s, 0, sizeof s);
+        memcpy(s, keys + (size_t)i * KW, KW);      /* little-endian rows (Builder) */
+        int64_t k = visit(s, succ, sr, r);
+        if (k < 0) break;
+        for (int64_t j = 0; j < k; j++) {
+            const U *t = succ + (size_t)j * W;
+            HASH_SLOT();
+            memcpy(tb, t, KW);
+            int32_t got = -1;
+            U step = 1;
+            for (;; step++) {
+                int32_t g = c->table[slot];
+                if (g < 0) break;
+                if (keq(keys + (size_t)g * KW, tb)) { got = g; break; }
+                slot = (slot + step) & tmask;
+            }
+            if (got < 0) {                 /* not stored: a candidate, -1 - its number */
+                U ls = hh & lmask;
+                for (U lstep = 1;; lstep++) {
+                    int32_t d = q->ltable[ls];
+                    if (d < 0) {
+                        d = (int32_t)nc++; q->ltable[ls] = d;
+                        memcpy(q->crow + (size_t)d * KW, tb, KW);
+                        q->cpar[d] = (int32_t)i; q->chash[d] = hh; q->cslot[d] = (int64_t)slot;
+                        q->cstep[d] = (int64_t)step; q->clocal[d] = (int32_t)ls;
+                    } else if (!keq(q->crow + (size_t)d * KW, tb)) {
+                        ls = (ls + lstep) & lmask;
+                        continue;
+                    }
+                    got = -1 - d;
+                    break;
+                }
+            }
+            q->ev[ne] = got; q->er[ne] = (RULE_T)sr[j]; ne++;
+        }
+        c->degree[i] = (uint16_t)k;
+    }
+    r->done = i; r->edges = ne; r->distinct = nc;
+}
+/* slice t's candidates: cown the earliest slice that has it, cidx its number there (new: among
+   the new ones of slice t); the number of new ones */
+static int64_t pmark(const Ctx *c, Slice *sl, int64_t t) {
+    Slice *q = &sl[t];
+    U lmask = ((U)1 << q->lbits) - 1;
+    int64_t fresh = 0;
+    for (int64_t d = 0; d < q->r.distinct; d++) {
+        const uint8_t *tb = q->crow + (size_t)d * KW;
+        int32_t own = (int32_t)t, at = -1;
+        for (int64_t u = 0; u < t && at < 0; u++) {
+            U ls = q->chash[d] & lmask;
+            for (U lstep = 1;; lstep++) {
+                int32_t e = sl[u].ltable[ls];
+                if (e < 0) break;
+                if (keq(sl[u].crow + (size_t)e * KW, tb)) { own = (int32_t)u; at = e; break; }
+                ls = (ls + lstep) & lmask;
+            }
+        }
+        q->cown[d] = own;
+        q->cidx[d] = at >= 0 ? at : (int32_t)fresh++;
+    }
+    return fresh;
+}
+/* the first free slot from `slot` on (probe step `step`) takes id, with a compare-and-swap:
+   other threads claim slots at the same time */
+static inline void pclaim(int32_t *table, U slot, U step, U tmask, int32_t id) {
+    for (;; step++) {
+        int32_t empty = -1;
+        if (__atomic_load_n(&table[slot], __ATOMIC_RELAXED) < 0 &&
+            __atomic_compare_exchange_n(&table[slot], &empty, id, 0, __ATOMIC_RELAXED, __ATOMIC_RELAXED))
+            return;
+        slot = (slot + step) & tmask;
+    }
+}
+/* rehash's part lo .. hi-1 on one of several threads at once (the slot order may differ) */
+void prehash(const uint8_t *keys, int64_t lo, int64_t hi, int32_t *table, int64_t tbits) {
+    U tmask = ((U)1 << tbits) - 1, t[W];
+    for (int64_t i = lo; i < hi; i++) {
+        memset(t, 0, sizeof t);
+        memcpy(t, keys + (size_t)i * KW, KW);
+        HASH_SLOT();
+        pclaim(table, slot, 1, tmask, (int32_t)i);
+    }
+}
+static void pinsert(const Ctx *c, Slice *sl, int64_t t) {
+    Slice *q = &sl[t];
+    U tmask = ((U)1 << c->tbits) - 1;
+    for (int64_t d = 0; d < q->r.distinct; d++) {
+        if (q->cown[d] != t) continue;
+        int32_t id = (int32_t)(q->base + q->cidx[d]);
+        memcpy(c->keys + (size_t)id * KW, q->crow + (size_t)d * KW, KW);
+        c->parent[id] = q->cpar[d];
+        pclaim(c->table, (U)q->cslot[d], (U)q->cstep[d], tmask, id);
+    }
+    int32_t *dst = c->dst + q->edge0;
+    RULE_T *rules = c->rules + q->edge0;
+    for (int64_t e = 0; e < q->r.edges; e++) {
+        int32_t v = q->ev[e];
+        if (v < 0) {
+            int32_t d = -1 - v, u = q->cown[d];
+            v = (int32_t)(u == t ? q->base + q->cidx[d] : sl[u].base + sl[u].cidx[q->cidx[d]]);
+        }
+        dst[e] = v;
+        rules[e] = q->er[e];
+    }
+}
+/* thread 0, before a round: the slices, or why not (the search is over, arrays to grow, a pause) */
+static void pplan(Ctx *c, Slice *sl) {
+    int64_t n = c->nslices;
+    c->cmark = 0;
+    if (c->status != P_RUN) return;
+    if (c->i == c->nk) { c->status = P_DONE; return; }
+    if (c->rounds-- <= 0) { c->status = P_PAUSE; return; }
+    int64_t room = c->tlimit - c->nk;            /* states the table takes at its load limit */
+    if (room < n * NRULES) { c->status = P_GROW; return; }
+    int64_t cap = room / n < c->edges_max ? room / n : c->edges_max;
+    if (c->kcap - c->nk < n * cap || c->ecap - c->ne < n * cap) { c->status = P_GROW; return; }
+    int64_t avail = c->nk - c->i;      /* may run on into the next layer's states stored already */
+    int64_t per = avail > c->narrow ? (avail + n - 1) / n : avail;     /* a narrow frontier: one thread */
+    if (per > cap / c->fan) per = cap / c->fan;
+    if (per < 1) per = 1;
+    if (c->dcap < c->i + n * per) { c->status = P_GROW; return; }
+    for (int64_t u = 0; u < n; u++) {
+        sl[u].a = c->i + u * per < c->nk ? c->i + u * per : c->nk;
+        sl[u].b = sl[u].a + per < c->nk ? sl[u].a + per : c->nk;
+    }
+    c->cap = cap;
+}
+/* thread 0, after the marks: bases and edge places of the kept slices, the counts, a hit */
+static void psettle(Ctx *c, Slice *sl) {
+    int64_t nk = c->nk, ne = c->ne, last = 0, busy = 0;
+    c->cexp = c->cins = 0;
+    for (int64_t u = 0; u < c->nslices && sl[u].kept; u++) {
+        sl[u].base = nk; nk += sl[u].fresh;
+        sl[u].edge0 = ne; ne += sl[u].r.edges;
+        last = u;
+    }
+    for (int64_t u = 0; u < c->nslices; u++) busy += sl[u].a < sl[u].b;
+    c->nrounds++;
+    c->nsplit += busy > 1;
+    c->ndropped += busy > last + 1;
+    Res *r = &sl[last].r;
+    c->seen_states += r->done - sl[0].a;
+    c->seen_edges += ne - c->ne;
+    c->nk = nk; c->ne = ne; c->i = r->done;
+    /* successors per state to plan for: twice the highest mean of this round's slices; after a
+       round that dropped slices, twice what was planned */
+    int64_t fan = 1;
+    for (int64_t u = 0; u <= last; u++) {
+        int64_t m = sl[u].r.done > sl[u].a ? (2 * sl[u].r.edges + sl[u].r.done - sl[u].a - 1) / (sl[u].r.done - sl[u].a) : 1;
+        if (m > fan) fan = m;
+    }
+    if (busy > last + 1) fan = 2 * c->fan;
+    c->fan = fan > NRULES ? NRULES : fan;
+    if (r->kind != 0 && r->kind != HIT_FULL) { c->hit = *r; c->status = P_HIT; }
+}
+/* the next slice of a step for this thread to take (the threads share each step's slices
+   as they come free: a thread held up by other load holds up the round less); -1 when none */
+static inline int64_t ptake(const Ctx *c, int64_t *next) {
+    int64_t k = __atomic_fetch_add(next, 1, __ATOMIC_RELAXED);
+    return k < c->nslices ? k : -1;
+}
+void prun(Ctx *c, Slice *sl, int64_t t) {
+    int64_t sense = 0, k;
+    for (;;) {
+        if (t == 0) pplan(c, sl);
+        pbarrier(c, &sense);
+        if (c->status != P_RUN) return;
+        while ((k = ptake(c, &c->cexp)) >= 0) pexpand(c, &sl[k]);
+        pbarrier(c, &sense);
+        while ((k = ptake(c, &c->cmark)) >= 0) {
+            Slice *q = &sl[k];
+            q->kept = q->a < q->b;
+            for (int64_t u = 0; u < k; u++) if (sl[u].r.done < sl[u].b) q->kept = 0;
+            q->fresh = q->kept ? pmark(c, sl, k) : 0;
+        }
+        pbarrier(c, &sense);
+        if (t == 0) psettle(c, sl);
+        pbarrier(c, &sense);
+        while ((k = ptake(c, &c->cins)) >= 0) {
+            Slice *q = &sl[k];
+            if (q->kept) pinsert(c, sl, k);
+            for (int64_t d = 0; d < q->r.distinct; d++) q->ltable[q->clocal[d]] = -1;   /* empty again */
+            q->r.distinct = 0;
+            if (!q->kept) q->r.edges = 0;
+        }
+    }
+}"""
+
+
 class _Src:
     """The C text of one model, from its variables' bit fields (compile.Layout)."""
 
     def __init__(self, model: Model, shift: dict[str, int], width: dict[str, int], total_bits: int):
         self.model, self.shift, self.width = model, shift, width
         self.words = max(1, -(-total_bits // 64))
+        self.row_bytes = StateStore.row_bytes(total_bits)
 
     def var(self, n: str, src: str = "s") -> str:
         return f"((I)getb({src}, {self.shift[n]}u, {self.width[n]}u))"
@@ -243,7 +496,7 @@ class _Src:
 
     def source(self) -> str:
         m, W = self.model, self.words
-        out = [_PRELUDE, _GRAPH_COMMON, f"#define W {W}"]
+        out = [_PRELUDE, _GRAPH_COMMON, f"#define W {W}", f"#define KW {self.row_bytes}", _KEQ]
         for n, text in m.defs:                  # definitions: pure functions of the state
             out.append(f"static inline I d_{n}(const U *s) {{ return {_c(expr.parse(text), self.name)}; }}")
         out += self.canon()
@@ -398,25 +651,24 @@ void bfs(int64_t i, int64_t stop, uint8_t *keys, int64_t nk, int64_t klimit, int
             layers[nl++] = stop = nk;
         }}
         if (nk + NRULES > klimit || ne + NRULES > ecap) {{ r->kind = {HIT_FULL}; break; }}
-        const uint8_t *row = keys + (size_t)i * (size_t)width;
         memset(s, 0, sizeof s);
-        for (int64_t j = 0; j < width; j++) s[j >> 3] |= (U)row[j] << (8 * (j & 7));
+        memcpy(s, keys + (size_t)i * KW, KW);      /* little-endian rows (Builder) */
         int64_t k = visit(s, succ, sr, r);
         if (k < 0) break;
         for (int64_t j = 0; j < k; j++) {{
             const U *t = succ + (size_t)j * W;
             HASH_SLOT();
-            for (int64_t b = 0; b < width; b++) tb[b] = (uint8_t)(t[b >> 3] >> (8 * (b & 7)));
+            memcpy(tb, t, KW);
             int32_t got;
             for (U step = 1;; step++) {{
                 got = table[slot];
                 if (got < 0) {{
                     got = (int32_t)nk; table[slot] = got;
-                    memcpy(keys + (size_t)nk * (size_t)width, tb, (size_t)width);
+                    memcpy(keys + (size_t)nk * KW, tb, KW);
                     parent[nk] = (int32_t)i; nk++;
                     break;
                 }}
-                if (memcmp(keys + (size_t)got * (size_t)width, tb, (size_t)width) == 0) break;
+                if (keq(keys + (size_t)got * KW, tb)) break;
                 slot = (slot + step) & tmask;
             }}
             dst[ne] = got; rules[ne] = ({rule_t})sr[j]; ne++;
@@ -429,14 +681,14 @@ void bfs(int64_t i, int64_t stop, uint8_t *keys, int64_t nk, int64_t klimit, int
 void rehash(const uint8_t *keys, int64_t n, int64_t width, int32_t *table, int64_t tbits) {{
     U tmask = ((U)1 << tbits) - 1, t[W];
     for (int64_t i = 0; i < n; i++) {{
-        const uint8_t *row = keys + (size_t)i * (size_t)width;
         memset(t, 0, sizeof t);
-        for (int64_t j = 0; j < width; j++) t[j >> 3] |= (U)row[j] << (8 * (j & 7));
+        memcpy(t, keys + (size_t)i * KW, KW);
         HASH_SLOT();
         for (U step = 1; table[slot] >= 0; step++) slot = (slot + step) & tmask;
         table[slot] = (int32_t)i;
     }}
 }}""")
+        out.append(_PARALLEL.replace("RULE_T", rule_t).replace("HIT_FULL", str(HIT_FULL)))
         return out
 
 

@@ -1,174 +1,183 @@
-"""Breadth-first safety search on several cores with a partitioned visited set (issue 12, item 4).
+"""The compiled breadth-first search on several threads over one store (issue 12, item 4).
 
-As in SPIN's multi-core mode and TLC's workers, every state has an owner: worker
-`mix64(state) % workers`. A worker keeps the visited set of its own states only
-(storage.StateStore used as a bare set: keys and hash table, no graph), expands the
-new states it owns with the generated `edges` function, and sends each successor to
-its owner. The layers are synchronised: the coordinating process relays the
-successor batches (as opaque pickled bytes) once every worker has finished a
-layer, so layer k of every worker holds exactly the states at distance k. The
-union of the layers, the edges expanded, the depth and the rule coverage are
-therefore those of the sequential search, and so is the verdict: every state is
-checked against the invariants and for deadlock when it is expanded, in both.
+As TLC's workers do, the threads share one visited set (the store's hash table,
+storage.StateStore) and split the states to expand; unlike a partition of the states
+by hash (SPIN's multi-core), no successors travel between workers, and the search
+writes the same store as the one-thread `bfs` (model_check.native), so responses,
+final checks and counterexamples run on it unchanged. The search goes in rounds, all
+in C (native.py `prun`, called on every thread; the threads meet at barriers in C):
 
-What it does not do: the response bounds and weak-fairness checks, and the models'
-final-state checks, need the stored graph (model_check.engine); a parallel run
-reports them as not checked. A violation's shortest trace is recomputed by the
-sequential search, which stops at the same layer.
+1. thread 0 cuts the next stored states (they may run on into the next layer) into
+   consecutive slices, SLICES per thread; in each step below the threads take the slices as
+   they come free, so a thread held up by other load holds the round up less;
+2. each slice is expanded against the table as it is (read only): an edge to a
+   stored state gets its id; a successor not stored becomes a candidate of the slice,
+   deduplicated in the slice's own table;
+3. a candidate an earlier slice has too is that slice's; the others are new, numbered in
+   first-seen order;
+4. each slice's new states get ids after the stored states and the new ones of the slices
+   before it, so ids, parents (the source of a state's first edge) and edges are those of
+   the one-thread search; rows, parents, table slots (compare-and-swap) and edges are
+   written by all threads at once.
+
+A slice that fills its buffers (or holds a hit) ends the round there: the slices after it
+are expanded again in the next round. Only the hash table's slot order may differ from the
+one-thread search's (it is dropped after the search); tests/model_check/test_parallel.py
+compares everything else. Python sees the search every ROUNDS rounds (progress), at its
+end, at a hit, and to grow the arrays.
 """
 from __future__ import annotations
 
-import multiprocessing as mp
-import pickle
-import resource
-import time
+import ctypes
 from dataclasses import dataclass
+from concurrent.futures import ThreadPoolExecutor
+from typing import Callable
 
 import numpy as np
 
-from model_check.compile import Compiled, RangeError, compile_model
-from model_check.engine import SLICE, Progress, Result, explore
-from model_check.native import HIT_RANGE, Native
+from model_check.compile import RangeError
 from model_check.gcl import Model
-from model_check.storage import Meter, StateStore, mix64
+from model_check.native import HIT_RANGE, Native, range_message, _hit, _Res
+from model_check.storage import LOAD, StateStore
+
+NARROW = 1 << 11         # a frontier of at most this many states is expanded on one thread
+EDGES = 1 << 16          # edges a slice holds at most (its buffers: about 60 bytes each)
+SLICES = 2               # slices per thread in a round: the threads take them as they come free
+ROUNDS = 64              # rounds between returns to Python (the progress line)
+P_RUN, P_DONE, P_PAUSE, P_GROW, P_HIT = range(5)      # native.py `prun`'s status
 
 
 @dataclass
-class _Layer:
-    """What a worker reports after expanding one layer."""
+class Rounds:
+    """What the threads of a search did (for tests and the bench)."""
 
-    new: int                      # states of this layer it owns
-    edges: int                    # transitions it expanded
-    coverage: np.ndarray          # per rule
-    hit: tuple | None             # (kind, index, state) of a violation found, or None
-
-
-def _owners(store: StateStore, states: list[int], workers: int) -> np.ndarray:
-    return (mix64(store.to_words(states)) % np.uint64(workers)).astype(np.int64)
+    rounds: int = 0              # rounds (each: expand, mark, insert on every thread)
+    split: int = 0               # rounds with more than one slice of states
+    dropped: int = 0             # rounds where a slice stopped early (full buffers, a hit): the slices
+                                 # after it were expanded in vain, and again in the next round
 
 
-def _worker(me: int, workers: int, model: Model, comp: Compiled, conn, nat: Native | None = None) -> None:
-    """One partition: dedup what arrives, expand what is new, ship successors to their owners.
-    States travel as uint64 word rows with the C successor function (`nat`), as ints without."""
-    meter = Meter()
-    rules = len(model.rules)
-    store = StateStore(comp.layout.total_bits, rules)
-    init = store.to_words([comp.init])
-    mine = int((mix64(init) % np.uint64(workers))[0]) == me
-    incoming: list[int] | np.ndarray = (init if mine else init[:0]) if nat else ([comp.init] if mine else [])
-    while True:
-        if nat is None:
-            new: list[int] | np.ndarray = store.add_states(incoming)
-            nxt, rule, ends = [], [], []
-            hit = comp.edges(new, nxt, rule, ends) if new else None
-            edges, cov, out = len(nxt), np.bincount(np.asarray(rule, np.int64), minlength=rules), nxt
-            owner = _owners(store, nxt, workers) if nxt else np.zeros(0, np.int64)
-            buckets = [[nxt[i] for i in np.flatnonzero(owner == j).tolist()] for j in range(workers)]
-        else:
-            new = store.add_rows(incoming)
-            out, edges, cov, hit = _expand_rows(model, nat, new, rules)
-            owner = (mix64(out) % np.uint64(workers)).astype(np.int64)
-            buckets = [out[owner == j] for j in range(workers)]
-        conn.send(_Layer(len(new), edges, cov, hit))
-        for j in range(workers):
-            if j != me:
-                conn.send_bytes(pickle.dumps(buckets[j], pickle.HIGHEST_PROTOCOL))
-        if not conn.recv():                       # the coordinator says stop
-            conn.send((meter.peak(), store.nbytes))
-            conn.close()
-            return
-        parts = [buckets[me]] + [pickle.loads(conn.recv_bytes()) for j in range(workers) if j != me]
-        incoming = np.concatenate(parts) if nat else [s for part in parts for s in part]
+class _CSlice(ctypes.Structure):
+    _fields_ = ([(f, ctypes.c_void_p) for f in ("ev", "er", "crow", "cpar", "chash", "cslot", "cstep", "clocal",
+                                                  "ltable", "cown", "cidx")]
+                + [(f, ctypes.c_int64) for f in ("lbits", "a", "b", "edge0", "fresh", "base", "kept")]
+                + [("r", _Res)])
 
 
-def _expand_rows(model: Model, nat: Native, new: np.ndarray, rules: int):
-    """A worker's layer on the C successor function: (distinct successors of each call, edges,
-    coverage, hit) -- up to the first violation, like the Python `edges`."""
-    outs, edges, cov, a = [], 0, np.zeros(rules, np.int64), 0
-    while a < len(new):
-        chunk = nat.expand(new[a:a + SLICE])
-        outs.append(chunk.distinct)
-        edges += len(chunk.inv)
-        cov += np.bincount(chunk.rules, minlength=rules)
-        a += chunk.done
-        if chunk.kind == HIT_RANGE:
-            raise RangeError(chunk.range_message(model))
-        if chunk.hit() is not None:
-            return np.concatenate(outs), edges, cov, chunk.hit(int.from_bytes(new[a].astype("<u8").tobytes(), "little"))
-    return (np.concatenate(outs) if outs else new[:0]), edges, cov, None
+class _Ctx(ctypes.Structure):
+    _fields_ = ([(f, ctypes.c_void_p) for f in ("keys", "parent", "table", "dst", "rules", "degree")]
+                + [(f, ctypes.c_int64) for f in ("width", "tbits", "tlimit", "kcap", "ecap", "dcap", "nk", "ne", "i",
+                                                  "workers", "edges_max", "narrow", "fan", "seen_states",
+                                                  "seen_edges", "rounds", "status", "cap", "bcount", "bsense", "nrounds",
+                                                  "nsplit", "ndropped", "nslices", "cexp", "cmark", "cins")]
+                + [("hit", _Res)])
 
 
-def explore_parallel(model: Model, workers: int = 2, compiled: Compiled | None = None,
-                     progress: bool = True) -> Result:
-    """The sequential search's states, transitions, depth, coverage and safety verdict, on
-    `workers` processes (fork: the compiled model is inherited, not pickled)."""
-    comp = compiled or compile_model(model)
-    res = Result(model=model, compiled=comp, coverage=[0] * len(model.rules))
-    if model.responses or model.final_checks:
-        res.warnings.append(f"parallel search ({workers} workers) checks invariants and deadlocks only: "
-                            "responses and final-state checks need the stored graph (run without --workers)")
-    meter = Meter()
-    bar = Progress(model.name) if progress else None
-    t0, c0, ch0 = time.perf_counter(), time.process_time(), _children_cpu()
-    nat = comp.native()            # compiled once, before the fork: every worker inherits it
-    ctx = mp.get_context("fork")
-    conns, procs = [], []
-    for w in range(workers):
-        mine, theirs = ctx.Pipe()
-        p = ctx.Process(target=_worker, args=(w, workers, model, comp, theirs, nat), daemon=True)
-        p.start()
-        theirs.close()
-        conns.append(mine)
-        procs.append(p)
-    cov = np.zeros(len(model.rules), np.int64)
-    layers, hit = 0, None
-    try:
+class _Slice:
+    """One thread's buffers (numpy, kept alive here; C sees them through `_CSlice`)."""
+
+    def __init__(self, store: StateStore, edges: int, c: _CSlice):
+        self.arrays = {
+            "ev": np.empty(edges, np.int32),                 # per edge: the id, or -1 - candidate
+            "er": np.empty(edges, store.rule.data.dtype),    # per edge: the rule
+            "crow": np.empty((edges, store.width), np.uint8),  # per candidate: the state's row
+            "cpar": np.empty(edges, np.int32),                # ... the source of its first edge
+            "chash": np.empty(edges, np.uint64),              # ... its hash
+            "cslot": np.empty(edges, np.int64),               # ... where its probe of the table stopped
+            "cstep": np.empty(edges, np.int64),
+            "clocal": np.empty(edges, np.int32),              # ... its slot in `ltable`
+            "ltable": np.full(1 << (2 * edges - 1).bit_length(), -1, np.int32),   # the slice's own table
+            "cown": np.empty(edges, np.int32),                # ... the first slice that has it
+            "cidx": np.empty(edges, np.int32),                # ... its number there
+        }
+        for name, a in self.arrays.items():
+            setattr(c, name, a.ctypes.data)
+        c.lbits = (2 * edges - 1).bit_length()
+
+
+def search(model: Model, store: StateStore, lo: int, nat: Native, workers: int,
+           on_layer: Callable[[int, int], None], rounds: Rounds) -> tuple[tuple | None, int]:
+    """`engine._search_native` on `workers` threads: the search from the layer of ids
+    lo .. len(store)-1 into `store`; (hit, hit id) or (None, -1). `on_layer(first id, width)`
+    is called as each new layer begins; `rounds` counts what the threads did."""
+    prun = nat.lib.prun
+    prun.restype = None
+    edges = max(EDGES, nat.n_rules)              # room for one state's successors at least
+    nslices = workers * SLICES
+    csl = (_CSlice * nslices)()
+    slices = [_Slice(store, edges, csl[t]) for t in range(nslices)]      # noqa: F841 - the buffers C uses
+    ctx = _Ctx(workers=workers, nslices=nslices, width=store.width, edges_max=edges, narrow=NARROW,
+               fan=nat.n_rules, i=lo)
+    stop = len(store)
+    room = nslices * nat.n_rules
+    with ThreadPoolExecutor(workers - 1) as pool:
+        store.rehash = lambda keys, table, bits: _rehash(nat, pool, workers, keys, table, bits)
         while True:
-            reports, batches = [], []
-            for w, conn in enumerate(conns):
-                reports.append(conn.recv())
-                batches.append({j: conn.recv_bytes() for j in range(workers) if j != w})
-            new = sum(r.new for r in reports)
-            res.states += new
-            res.transitions += sum(r.edges for r in reports)
-            cov += sum(r.coverage for r in reports)
-            layers += 1 if new else 0
-            hit = next((r.hit for r in reports if r.hit is not None), None)
-            go = new > 0 and hit is None
-            for j, conn in enumerate(conns):
-                conn.send(go)
-                if go:
-                    for w in range(workers):
-                        if w != j:
-                            conn.send_bytes(batches[w][j])
-            if bar:
-                bar.update(layers - 1, res.states, new)
-            if not go:
-                break
-        finals = [conn.recv() for conn in conns]            # (resident peak, visited-set bytes)
-    finally:
-        for conn in conns:
-            conn.close()
-        for p in procs:
-            p.join(timeout=10)
-            if p.is_alive():                     # pragma: no cover - only after an error above
-                p.terminate()
-    res.depth = max(layers - 1, 0)
-    res.coverage = cov.tolist()
-    res.seconds = time.perf_counter() - t0
-    res.peak_bytes = meter.peak() + sum(peak for peak, _ in finals)   # the coordinator and every worker
-    res.store_bytes = sum(size for _, size in finals)
-    res.cpu = time.process_time() - c0 + _children_cpu() - ch0     # workers: RUSAGE_CHILDREN
-    res.times["search"] = res.cpu
-    if hit is not None:
-        # the sequential search stops in the same layer and gives the shortest trace
-        seq = explore(model, comp, progress=False, check_liveness=False)
-        res.violation = seq.violation
-        res.warnings.append("state and transition counts of a failing parallel run cover whole layers: "
-                            "the sequential search stops inside the layer of the first violation")
-    return res
+            _bind(ctx, store)
+            ctx.status, ctx.rounds, ctx.bcount, ctx.bsense = P_RUN, ROUNDS, 0, 0
+            ctx.cexp = ctx.cmark = ctx.cins = 0
+            futures = [pool.submit(prun, ctypes.byref(ctx), csl, ctypes.c_int64(t)) for t in range(1, workers)]
+            prun(ctypes.byref(ctx), csl, ctypes.c_int64(0))
+            for f in futures:
+                f.result()
+            rounds.rounds, rounds.split, rounds.dropped = ctx.nrounds, ctx.nsplit, ctx.ndropped
+            store.keys.n = store.parent.n = ctx.nk
+            store.dst.n = store.rule.n = ctx.ne
+            store.degree.n = i = ctx.i
+            stop = _layers(store, stop, i, on_layer)
+            if ctx.status == P_DONE:
+                return None, -1
+            if ctx.status == P_HIT:
+                h = ctx.hit
+                if h.kind == HIT_RANGE:
+                    raise RangeError(range_message(model, int(h.rule), int(h.var), int(h.value)))
+                return _hit(int(h.kind), int(h.index), None), i
+            if ctx.status == P_GROW:             # what a round may need at most; the table as `bfs` grows it
+                if int(LOAD * len(store.table)) - len(store) < room:     # type: ignore[arg-type]
+                    store.reserve(room, 0, 0)
+                for g in (store.keys, store.parent, store.dst, store.rule, store.degree):
+                    g.reserve(nslices * edges)
 
 
-def _children_cpu() -> float:
-    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return ru.ru_utime + ru.ru_stime
+def _rehash(nat: Native, pool: ThreadPoolExecutor, workers: int, keys: np.ndarray, table: np.ndarray,
+            bits: int) -> None:
+    """`Native.rehash` on all the threads (a part of the rows each; the serial rehash was
+    6.6% of a two-thread profile): the empty `table` gets the ids of the stored rows."""
+    fn = nat.lib.prehash
+    fn.restype = None
+    p, n64 = ctypes.c_void_p, ctypes.c_int64
+    cuts = [len(keys) * t // workers for t in range(workers + 1)]
+    args = [(p(keys.ctypes.data), n64(cuts[t]), n64(cuts[t + 1]), p(table.ctypes.data), n64(bits))
+            for t in range(workers)]
+    futures = [pool.submit(fn, *a) for a in args[1:]]
+    fn(*args[0])
+    for f in futures:
+        f.result()
+
+
+def _bind(ctx: _Ctx, store: StateStore) -> None:
+    """The store's arrays (they move as they grow) and counts, for `prun`."""
+    for name, g in (("keys", store.keys), ("parent", store.parent), ("dst", store.dst), ("rules", store.rule),
+                    ("degree", store.degree)):
+        setattr(ctx, name, g.data.ctypes.data)
+    ctx.table = store.table.ctypes.data         # type: ignore[union-attr]
+    ctx.tbits, ctx.tlimit = store.table_bits, int(LOAD * len(store.table))   # type: ignore[arg-type]
+    ctx.kcap = min(len(store.keys.data), len(store.parent.data))
+    ctx.ecap = min(len(store.dst.data), len(store.rule.data))
+    ctx.dcap = len(store.degree.data)
+    ctx.nk, ctx.ne = len(store), store.dst.n
+
+
+def _layers(store: StateStore, stop: int, done: int, on_layer: Callable[[int, int], None]) -> int:
+    """Report the layers that began once the states before `done` were expanded; the layer
+    being expanded ends before the returned id. A new state's parent is the first state with
+    an edge to it, so parents grow with ids: the layer after `stop` ends at the first state
+    whose parent is not below `stop` (where `bfs`'s count was when it reached `stop`)."""
+    parent = store.parent.view
+    while stop <= done:
+        end = stop + int(np.searchsorted(parent[stop:], stop))
+        if end == stop:
+            break
+        on_layer(stop, end - stop)
+        stop = end
+    return stop

@@ -170,9 +170,14 @@ def ranges(offsets: np.ndarray, ids: np.ndarray) -> np.ndarray:
 class StateStore:
     """Visited states, BFS parents and the edge list, for one search."""
 
+    @staticmethod
+    def row_bytes(total_bits: int) -> int:
+        """Stored bytes per state: no padding to words (native.py's C knows it as KW)."""
+        return max(1, -(-total_bits // 8))
+
     def __init__(self, total_bits: int, rules: int):
         self.words = max(1, -(-total_bits // 64))
-        self.width = max(1, -(-total_bits // 8))      # stored bytes per state: no padding to words
+        self.width = self.row_bytes(total_bits)
         self.keys = Grow(np.uint8, self.width, 1 << 12)
         self.parent = Grow(np.int32, 0, 1 << 12)
         self.degree = Grow(np.uint16, 0, 1 << 12)

@@ -110,19 +110,16 @@ void irrc_on_set_alarm_irrc(irrc_node *node, const arachnae_header *h, const ara
         fw_alarm_set(&st.alarms[b], (int16_t)raw, FW_BELOW);
 }
 
-void irrc_on_xmit_data(irrc_node *node, const arachnae_header *h)
+/* seed 3.2.11: the skeleton answers with XMIT_DATA_IRRC what this fills in (spec reply_to) */
+uint8_t irrc_on_xmit_data(irrc_node *node, const arachnae_header *h, arachnae_xmit_data_irrc_t *m)
 {
-    arachnae_xmit_data_irrc_t m;
-    uint8_t out[ARACHNAE_XMIT_DATA_IRRC_FRAME_MAX];
-    uint16_t n = 0;
-    if (h->dst == ARACHNAE_ADDR_BROADCAST)
-        return;
+    (void)h;
+    (void)node;
     fw_fetched(&st.slave);
-    m.left = (uint8_t)st.latest[0];
-    m.center = (uint8_t)st.latest[1];
-    m.right = (uint8_t)st.latest[2];
-    if (arachnae_xmit_data_irrc_build(&m, h->src, node->address, out, sizeof out, &n) == ARACHNAE_OK)
-        irrc_send(node, out, n);
+    m->left = (uint8_t)st.latest[0];
+    m->center = (uint8_t)st.latest[1];
+    m->right = (uint8_t)st.latest[2];
+    return 1;
 }
 
 void fw_behaviour_init(void *vnode)

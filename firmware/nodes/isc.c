@@ -50,18 +50,15 @@ void isc_on_set_alarm_isc(isc_node *node, const arachnae_header *h, const arachn
         fw_alarm_set(&st.alarms[msg->channel], msg->limit, FW_BEYOND);
 }
 
-void isc_on_xmit_data(isc_node *node, const arachnae_header *h)
+/* seed 3.2.11: the skeleton answers with XMIT_DATA_ISC what this fills in (spec reply_to) */
+uint8_t isc_on_xmit_data(isc_node *node, const arachnae_header *h, arachnae_xmit_data_isc_t *m)
 {
-    arachnae_xmit_data_isc_t m;
-    uint8_t out[ARACHNAE_XMIT_DATA_ISC_FRAME_MAX];
-    uint16_t n = 0;
-    if (h->dst == ARACHNAE_ADDR_BROADCAST)
-        return;
+    (void)h;
+    (void)node;
     fw_fetched(&st.slave);
-    m.longitudinal = (int8_t)st.latest[0];
-    m.transverse = (int8_t)st.latest[1];
-    if (arachnae_xmit_data_isc_build(&m, h->src, node->address, out, sizeof out, &n) == ARACHNAE_OK)
-        isc_send(node, out, n);
+    m->longitudinal = (int8_t)st.latest[0];
+    m->transverse = (int8_t)st.latest[1];
+    return 1;
 }
 
 void fw_behaviour_init(void *vnode)

@@ -89,17 +89,14 @@ void psc_on_set_alarm_psc(psc_node *node, const arachnae_header *h, const arachn
     fw_alarm_set(&st.alarm, (int16_t)raw, FW_BELOW);
 }
 
-void psc_on_xmit_data(psc_node *node, const arachnae_header *h)
+/* seed 3.2.11: the skeleton answers with XMIT_DATA_PSC what this fills in (spec reply_to) */
+uint8_t psc_on_xmit_data(psc_node *node, const arachnae_header *h, arachnae_xmit_data_psc_t *m)
 {
-    arachnae_xmit_data_psc_t m;
-    uint8_t out[ARACHNAE_XMIT_DATA_PSC_FRAME_MAX];
-    uint16_t n = 0;
-    if (h->dst == ARACHNAE_ADDR_BROADCAST)
-        return;
+    (void)h;
+    (void)node;
     fw_fetched(&st.slave);
-    m.voltage = (uint8_t)(st.last3.n ? fw_last3_mean(&st.last3) : reading());
-    if (arachnae_xmit_data_psc_build(&m, h->src, node->address, out, sizeof out, &n) == ARACHNAE_OK)
-        psc_send(node, out, n);
+    m->voltage = (uint8_t)(st.last3.n ? fw_last3_mean(&st.last3) : reading());
+    return 1;
 }
 
 void fw_behaviour_init(void *vnode)

@@ -67,17 +67,14 @@ void tpsc_on_status_req(tpsc_node *node, const arachnae_header *h, arachnae_stat
     reply->status = ARACHNAE_ORDER_STATUS_IN_ORDER; /* seed 3.2.12: the TPSC always answers IN_ORDER */
 }
 
-void tpsc_on_xmit_data(tpsc_node *node, const arachnae_header *h)
+/* seed 3.2.11: the skeleton answers with XMIT_DATA_TPSC what this fills in (spec reply_to) */
+uint8_t tpsc_on_xmit_data(tpsc_node *node, const arachnae_header *h, arachnae_xmit_data_tpsc_t *m)
 {
-    arachnae_xmit_data_tpsc_t m;
-    uint8_t out[ARACHNAE_XMIT_DATA_TPSC_FRAME_MAX];
-    uint16_t n = 0;
-    if (h->dst == ARACHNAE_ADDR_BROADCAST)
-        return;
-    m.contact = st.latched ? st.latched : st.contact;
-    if (arachnae_xmit_data_tpsc_build(&m, h->src, node->address, out, sizeof out, &n) == ARACHNAE_OK)
-        tpsc_send(node, out, n);
+    (void)h;
+    (void)node;
+    m->contact = st.latched ? st.latched : st.contact;
     st.latched = 0;
+    return 1;
 }
 
 void fw_behaviour_init(void *vnode)

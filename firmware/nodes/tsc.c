@@ -74,18 +74,16 @@ void tsc_on_set_alarm_tsc(tsc_node *node, const arachnae_header *h, const arachn
         fw_alarm_set(&st.alarms[msg->channel], msg->limit, FW_ABOVE);
 }
 
-void tsc_on_xmit_data(tsc_node *node, const arachnae_header *h)
+/* seed 3.2.11: the skeleton answers with XMIT_DATA_TSC what this fills in (spec reply_to) */
+uint8_t tsc_on_xmit_data(tsc_node *node, const arachnae_header *h, arachnae_xmit_data_tsc_t *m)
 {
-    arachnae_xmit_data_tsc_t m;
-    uint8_t out[ARACHNAE_XMIT_DATA_TSC_FRAME_MAX];
-    uint16_t n = 0;
     uint8_t ch, k;
-    if (h->dst == ARACHNAE_ADDR_BROADCAST)
-        return;
+    (void)node;
+    (void)h;
     if (!st.probes)
         measure(hal_ms());
     if (!st.probes)
-        return;                              /* no probe fitted: nothing to send */
+        return 0;                            /* no probe fitted: nothing to send */
     if (st.n_alarmed) {
         ch = st.alarmed[0];
         for (k = 1; k < st.n_alarmed; k++)
@@ -97,10 +95,9 @@ void tsc_on_xmit_data(tsc_node *node, const arachnae_header *h)
     }
     if (!st.n_alarmed)
         fw_fetched(&st.slave);
-    m.channel = ch;
-    m.temperature = (int8_t)st.latest[ch];
-    if (arachnae_xmit_data_tsc_build(&m, h->src, node->address, out, sizeof out, &n) == ARACHNAE_OK)
-        tsc_send(node, out, n);
+    m->channel = ch;
+    m->temperature = (int8_t)st.latest[ch];
+    return 1;
 }
 
 void fw_behaviour_init(void *vnode)

@@ -134,21 +134,18 @@ void usrc_on_free_run(usrc_node *node, const arachnae_header *h)
     }
 }
 
-void usrc_on_xmit_data(usrc_node *node, const arachnae_header *h)
+/* seed 3.2.11: the skeleton answers with XMIT_DATA_USRC what this fills in (spec reply_to) */
+uint8_t usrc_on_xmit_data(usrc_node *node, const arachnae_header *h, arachnae_xmit_data_usrc_t *m)
 {
     /* the last sector's nearest echo once announced, else the last measured distance (3.2.11) */
-    arachnae_xmit_data_usrc_t m;
-    uint8_t out[ARACHNAE_XMIT_DATA_USRC_FRAME_MAX];
-    uint16_t n = 0;
     echo_t e = st.has_ready ? st.ready : st.latest;
-    if (h->dst == ARACHNAE_ADDR_BROADCAST)
-        return;
+    (void)node;
+    (void)h;
     st.has_ready = 0;
     fw_fetched(&st.slave);
-    m.distance = e.distance;
-    m.angle = e.angle;
-    if (arachnae_xmit_data_usrc_build(&m, h->src, node->address, out, sizeof out, &n) == ARACHNAE_OK)
-        usrc_send(node, out, n);
+    m->distance = e.distance;
+    m->angle = e.angle;
+    return 1;
 }
 
 void fw_behaviour_init(void *vnode)

@@ -1,11 +1,14 @@
 /*
- * Echo firmware for testing the SIL host: every byte received on USART0 at 2400
- * baud is sent back plus one, with PD2 (RS-485 DE) high while sending.
+ * Echo firmware for testing the SIL host: every byte received on USART0 at the
+ * sensor bus's baud rate is sent back plus one, with PD2 (RS-485 DE) high while
+ * sending. The rate is the spec's (seed 3.2.1): the TPSC's build configuration
+ * (firmware/roles.py config), so no bus constant is typed in here.
  */
 #include <avr/interrupt.h>
 #include <avr/io.h>
 
-#define BAUD 2400UL
+#include "role_config.h"
+#define BAUD FW_BAUD
 #include <util/setbaud.h>
 
 ISR(USART_RX_vect)

@@ -139,3 +139,26 @@ def test_five_legged_wave_keeps_the_body_supported(write, lost):
     fwd, left, _ = body_motion(before, w.robot.pose)
     assert fwd > 0.8 * w.gait.speed()[0] * 12 and abs(left) < 0.02
     assert w.robot.events.unstable_steps == steps       # statically stable: four feet always hold the body
+
+
+@pytest.mark.parametrize("first, then", [(SIDESTEP_RIGHT, SIDESTEP_LEFT), (BACKWARD, SIDESTEP_LEFT),
+                                         (SIDESTEP_RIGHT, FORWARD)])
+def test_ripple_direction_change_costs_the_same_at_any_phase(write, first, then):
+    """A reversal walks the pattern backwards in place, a change between straight lines keeps the rhythm:
+    the motion in a fixed time after the key no longer depends on where in the cycle it lands (issue 17)."""
+    cycle = P.half_cycle / (1 - pattern(RIPPLE, P.legs)[0])
+    moved = []
+    for k in range(4):                                 # the key at four points of one sixth of a cycle
+        w = Walk(write)
+        w.gait.set_command(RIPPLE)
+        w.gait.set_command(first)
+        w.run(cycle + k * cycle / 24)
+        w.gait.set_command(then)
+        before = w.robot.pose
+        w.run(2.5)
+        fwd, left, _ = body_motion(before, w.robot.pose)
+        moved.append(fwd if then == FORWARD else left)
+        assert w.robot.events.unstable_steps == 0 and w.max_jump < P.servo_speed * P.dt * 0.2
+    nominal = w.gait.speed()[0] * 2.5
+    assert min(moved) > 0.6 * nominal, moved
+    assert max(moved) - min(moved) < 0.1 * nominal, moved

@@ -11,7 +11,8 @@ from arachnae_proto.enums import MmcError, MovCmd, RangeStatus, RecordKind, Tpsc
 from arachnae_proto.network import ADDRESS_OF
 from behaviours import tuning as T
 from behaviours.np3 import DeadReckoning, Echo, Ping, decode
-from behaviours.np3_layers import TaskModule, Tuning, body_frame, clear_ahead, light_gradient, np3_network, wall_beside
+from behaviours.np3_layers import (LSC_STEP_LOG, TaskModule, Tuning, body_frame, clear_ahead, light_gradient, np3_network,
+                                   wall_beside)
 from behaviours.units import age_byte, quantizer
 from tests.behaviours.rig import Rig
 
@@ -24,8 +25,16 @@ def grant(frame):
     return [(MCP, M.XmitGrant())] if isinstance(frame.message, M.XmitReq) else []
 
 
-def np3(spec, task: str = "forward") -> Rig:
+IR_CLEAR = quantizer(M.XmitDataIrrc, "center").hi     # an IR beam that sees nothing within its range
+
+
+def np3(spec, task: str = "forward", ir_first: bool = True) -> Rig:
+    """The NP3 with INIT at 0.05 s; `ir_first`: the SPU's first polls of the IR (nothing in range) and the
+    whiskers (no contact) reach it before (tuning.SPU_FIRST_POLL)."""
     rig = Rig(spec, "NP3", NP3, grant, task=task)
+    if ir_first:
+        rig.inject(0.03, MCP, data("IRRC", IR_CLEAR))
+        rig.inject(0.04, MCP, data("TPSC", 0))
     rig.inject(0.05, MCP, M.Init())
     return rig
 
@@ -47,16 +56,36 @@ def test_init_starts_the_task_and_a_whisker_contact_backs_off_within_the_reactio
     rig.run(1.0)
     assert moves(rig) == [(pytest.approx(0.05, abs=0.05), MovCmd.FORWARD)]
     rig.inject(2.0, MCP, data("TPSC", int(TpscContact.OBJ_BOTH)))          # head-on contact
-    rig.run(7.0)
+    manoeuvre = T.NP3_CONTACT_BACK_S + (90 + T.NP3_CONTACT_CLEAR_DEG) / T.NP3_DR_TURN_DEG_S   # back, turn ~110 deg
+    end = 2.0 + manoeuvre + 0.5 + 0.5                  # the 0.5 s hold and a little more
+    rig.run(end)
     after = [(t, m) for t, m in moves(rig) if t >= 2.0]
     assert after[0][1] == MovCmd.BACKWARD and after[0][0] - 2.0 < 0.1     # seed 5.2: well within 1 s
     assert any(m in (MovCmd.TURN_LEFT, MovCmd.TURN_RIGHT) for _t, m in after[1:])
-    assert command_at(rig, 7.0) == MovCmd.FORWARD         # back to the task after 1.6 + 2.4 s and the 0.5 s hold
+    assert command_at(rig, end - 1.0) != MovCmd.FORWARD   # still turning away from the surface ahead
+    assert command_at(rig, end) == MovCmd.FORWARD         # back to the task after the manoeuvre and the hold
     metrics = rig.node.debug_metrics()
     assert set(metrics["control"]) == {"task", "reflexes"}
-    assert sum(metrics["control"].values()) == pytest.approx(7.0 - 0.05, abs=0.15)
-    assert metrics["control"]["reflexes"] == pytest.approx(1.6 + 2.4 + 0.5, abs=0.15)
+    assert sum(metrics["control"].values()) == pytest.approx(end - 0.05, abs=0.15)
+    assert metrics["control"]["reflexes"] == pytest.approx(manoeuvre + 0.5, abs=0.15)
     assert metrics["switches"] == 2 and metrics["takeovers"]["contact"] == 1
+
+
+def test_switched_on_the_first_step_waits_for_what_the_ir_sees(spec):
+    """seed 5.2: next to a wall at power-on the robot must not walk before its close range is known: no MOVE
+    after INIT until the IR's and the whiskers' first records, at once after them; without, after NP3_START_LOOK_S."""
+    rig = np3(spec, ir_first=False)
+    rig.inject(0.3, MCP, data("IRRC", IR_CLEAR, channel=1))
+    rig.run(0.5)
+    assert moves(rig) == []                             # the IR alone: the whiskers may still touch something
+    rig.inject(0.6, MCP, data("TPSC", 0))
+    rig.run(1.0)
+    assert moves(rig)[0][1] == MovCmd.FORWARD and 0.6 < moves(rig)[0][0] <= 0.6 + T.NP3_PERIOD_S + 0.02   # next period
+    silent = np3(spec, ir_first=False)                  # the IRRC never reports (absent, or its bus broken)
+    silent.run(0.05 + T.NP3_START_LOOK_S - 0.1)
+    assert moves(silent) == []
+    silent.run(0.05 + T.NP3_START_LOOK_S + 0.15)
+    assert [m for _t, m in moves(silent)] == [MovCmd.FORWARD]
 
 
 def test_left_whisker_turns_right_without_backing_off(spec):
@@ -214,6 +243,33 @@ def test_seek_light_explores_towards_the_planned_goal_while_no_sample_shows_a_li
     assert (out["move"] == MovCmd.TURN_RIGHT) == steers_to_goal
 
 
+def test_seek_light_darkness_holds_through_noise_ends_at_a_brighter_sample_and_not_at_a_bright_plateau():
+    """seed 3.2.16: a shaded room reads the ambient light give or take 2 LSC steps; that is dark (explore the
+    map) for as long as it lasts, not a gradient to climb. A sample 8 steps brighter (the lamp seen past the
+    wall's end) ends it; readings flat at the lamp (the LSC saturated) are not dark: the light is here."""
+    t = Tuning()
+    task = TaskModule("seek_light", t)
+    assert t.light_flat_log > 2 * LSC_STEP_LOG
+    noise = [0, 2, 1, 0, 2, 1, 0, 2, 1, 2, 0, 1, 2, 0, 2, 1]
+    seq = 0
+
+    def sample(log_lux: float) -> None:
+        nonlocal seq
+        seq += 1
+        x, y = 0.3 * (seq % 4), 0.3 * (seq // 4 % 4)          # spread in both directions: a fit is possible
+        task.step({"light": (seq, x, y, log_lux), "pose": (x, y, 0.0)}, 2.5 * seq)
+
+    for k, n in enumerate(noise):
+        sample(0.7 + n * LSC_STEP_LOG)
+        assert task.dark() == (k + 1 >= t.light_samples)       # dark from the first full set on, and it holds
+    assert task.gradient is None                               # no gradient fitted to the noise
+    sample(0.7 + 8 * LSC_STEP_LOG)
+    assert not task.dark()
+    for _k in range(2 * t.light_samples):                      # at the lamp: flat, but far above the ambient
+        sample(3.0)
+        assert not task.dark()
+
+
 def test_seek_light_walks_round_an_obstacle_on_one_side():
     t = Tuning()
     task = TaskModule("seek_light", t)
@@ -228,6 +284,26 @@ def test_seek_light_walks_round_an_obstacle_on_one_side():
     assert math.copysign(1.0, h2) == side
     # nothing in the way: straight for the target
     assert task._detour({"echoes": ()}, (0.0, 0.0, 0.0), 0.3, 20.0) == 0.3
+
+
+def test_a_detour_keeps_clear_of_the_mapped_obstacle_the_echo_memory_has_let_go():
+    t = Tuning()
+    wall = tuple((0.4, -0.6 + 0.05 * k, 0.0, 0.0) for k in range(25))     # the same wall, now only on the map
+    task = TaskModule("seek_light", t)
+    assert task._detour({"echoes": (), "mapped": ()}, (0.0, 0.0, 0.0), 0.0, 0.0) == 0.0
+    h = task._detour({"echoes": (), "mapped": wall}, (0.0, 0.0, 0.0), 0.0, 0.0)
+    assert abs(math.degrees(h)) >= 40
+    assert clear_ahead(body_frame(wall, (0.0, 0.0, h)), t.avoid_half_width_m) >= t.light_clear_m
+
+
+def test_the_node_senses_the_mapped_obstacles_round_it(spec):
+    metres = quantizer(M.XmitDataUsrc, "distance")
+    rig = np3(spec, task="seek_light")
+    for k in range(0, 360, 5):                                               # walls 0.8 m all round
+        rig.inject(0.1 + k / 400, MCP, data("USRC", metres.raw(0.8), VALUE, channel=k))
+    rig.run(2.0)
+    mapped = rig.node.layers.sensors["mapped"]
+    assert mapped and all(0.6 < math.hypot(mx, my) <= T.NP3_MAPPED_NEAR_M for mx, my, _s, _a in mapped)
 
 
 def test_dead_reckoning_counts_sidesteps():

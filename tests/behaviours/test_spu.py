@@ -206,8 +206,21 @@ def test_a_whisker_contact_is_fetched_and_forwarded(spec):
     rig, _ = spu(spec)
     rig.inject(3.0, A["TPSC"], M.DataRdy())
     rig.run(3.5)
-    rec, = records(rig, "TPSC")
+    rec, = records(rig, "TPSC", after=3.0)
     assert (rec.kind, rec.value) == (RecordKind.VALUE, TpscContact.OBJ_LEFT)
+
+
+def test_after_post_the_close_range_is_polled_first_and_forwarded(spec):
+    """seed 5.2: switched on touching a wall, the TPSC's DATA_RDY came while the SPU was still in POST and was
+    lost; the SPU asks the IR and the whiskers (tuning.SPU_FIRST_POLL) before setting up any alarm, and the
+    NP3 gets what they sense (the scripted whisker touches on the left)."""
+    rig, _ = spu(spec)
+    to_sensors = [(type(f.message), f.dst) for _t, _bus, f in rig.sent if f.dst != A["MCP"]]
+    set_up = next(i for i, (cls, _dst) in enumerate(to_sensors) if cls.__name__.startswith("SetAlarm"))
+    assert M.XmitData not in [cls for cls, _dst in to_sensors[:set_up - 2]]        # none during the POST
+    assert to_sensors[set_up - 2:set_up] == [(M.XmitData, A[r]) for r in T.SPU_FIRST_POLL]
+    rec, = [r for r in records(rig, "TPSC") if r.kind == RecordKind.VALUE]
+    assert rec.value == TpscContact.OBJ_LEFT
 
 
 def test_asked_for_its_id_again_after_reporting_the_spu_runs_a_new_post(spec):

@@ -7,6 +7,7 @@ import pytest
 
 from arachnae_proto.enums import MovCmd
 from behaviours.np3_layers import AVOIDANCE, REFLEXES, TASK
+from behaviours import tuning as T
 from behaviours.np3_layers import np3_network
 from behaviours.subsumption import NONE_LAYER, FunctionModule, Network
 
@@ -96,8 +97,10 @@ def test_trace_intervals_cover_the_run_and_summary_sums_per_layer():
     summary = trace.summary(until=30.0)
     assert sum(summary.values()) == pytest.approx(28.0)
     assert set(summary) == {TASK, REFLEXES, AVOIDANCE}
-    # the contact reflex's manoeuvre is 1.6 + 2.4 s, plus its suppressor's hold of 0.5 s
-    assert summary[REFLEXES] == pytest.approx(1.6 + 2.4 + 0.5 - 0.1, abs=0.11)
+    # both whiskers, IR clear: a surface square ahead: back off, turn until it is contact_clear_deg behind the
+    # side, plus the suppressor's hold of 0.5 s
+    turn_s = (90 + T.NP3_CONTACT_CLEAR_DEG) / T.NP3_DR_TURN_DEG_S
+    assert summary[REFLEXES] == pytest.approx(T.NP3_CONTACT_BACK_S + turn_s + 0.5 - 0.1, abs=0.11)
     assert trace.switches(until=30.0) == 4          # task, reflexes, task, avoidance, task
     assert NONE_LAYER not in summary                # the task drives from the very first step
 

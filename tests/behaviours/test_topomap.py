@@ -6,7 +6,7 @@ import math
 import pytest
 from PIL import Image
 
-from behaviours.topomap import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, Reading, TopoMap, full_scan
+from behaviours.topomap import FREE, OCCUPIED, UNKNOWN, FrontierTarget, OccupancyGrid, Reading, TopoMap, full_scan
 
 Segment = tuple[tuple[float, float], tuple[float, float]]
 
@@ -187,9 +187,11 @@ def test_a_route_goes_round_through_the_door_and_never_through_the_wall(tmp_path
     crossing = [(a, b) for a, b in legs if (a[0] < 4) != (b[0] < 4)]
     assert crossing and all(1.5 < (a[1] + b[1]) / 2 < 2.5 for a, b in crossing)    # through the door (y 1.5..2.5)
     opened.plan = route
-    out = opened.save_png(tmp_path / "plan.png")
+    out = opened.save_png(tmp_path / "plan.png", given_up=[(1.0, 1.0)])
     img = Image.open(out).convert("RGB")
     assert any(img.getpixel((x, y)) == (0, 170, 60) for x in range(img.width) for y in range(0, img.height, 2))
+    i, j = opened.grid.cell(1.0, 1.0)                              # a frontier given up: a cross there
+    assert img.getpixel((i * 4 + 2, (opened.grid.ny - 1 - j) * 4 + 2)) == (150, 40, 170)
 
 
 def test_pits_found_are_barriers_and_the_route_takes_their_one_gap_then_replans_when_it_closes():
@@ -219,3 +221,104 @@ def test_pits_found_are_barriers_and_the_route_takes_their_one_gap_then_replans_
     pits(4.4, 6.0)                                                        # pits found in the gap too
     m.rebuild()
     assert m.route(start, goal) is None
+
+
+def strip_map() -> TopoMap:
+    """A free strip x 0.5..4.8 along y = 1 between two lines of pits (x 0.2..3.6), open onto unknown space at
+    both ends."""
+    g = OccupancyGrid(-1.0, -1.0, 8.0, 4.0, 0.1)
+    for k in range(81):
+        g.mark_free(0.5 + 0.05 * k, 1.0, 0.3)
+    for k in range(69):
+        g.mark_barrier(0.2 + 0.05 * k, 0.6)
+        g.mark_barrier(0.2 + 0.05 * k, 1.4)
+    m = TopoMap(g, robot_radius_m=0.16, place_spacing_m=0.5)
+    m.rebuild()
+    return m
+
+
+def test_frontier_target_is_kept_until_not_approached_then_given_up_for_good():
+    """seed 3.3.2: the robot keeps to the frontier it chose although another one became nearer, gives it up
+    when its route has not shortened for the patience time, and then never chooses it again."""
+    m = strip_map()
+    ft = FrontierTarget(exclude_m=0.5, progress_m=0.3, patience_s=40.0)
+    route = ft.route(m, 1.5, 1.0, 0.0, reached_m=0.2, min_size=3)
+    first = ft.target
+    assert route and first is not None and first[0] < 0.6 and route[-1] == first   # the near (left) end
+    route = ft.route(m, 2.8, 1.0, 10.0, reached_m=0.2, min_size=3)                  # now the right end is nearer
+    assert ft.target == first and route[-1] == first                                  # kept
+    route = ft.route(m, 2.8, 1.0, 41.0, reached_m=0.2, min_size=3)                  # not approached for 41 s
+    assert ft.given_up == [first] and ft.target is not None and ft.target[0] > 3.5 and route[-1] == ft.target
+    ft.target = None                                                                  # a fresh choice near the
+    ft.route(m, 1.5, 1.0, 50.0, reached_m=0.2, min_size=3)                          # left end: not the given-up one
+    assert ft.target is not None and ft.target[0] > 3.5
+    right = ft.target
+    ft.route(m, right[0] - 0.4, right[1], 60.0, reached_m=0.2, min_size=3)          # within 0.5 m: reached
+    assert ft.given_up == [first, right] and ft.target != right
+
+
+def test_frontier_target_replans_round_pits_found_on_the_way_and_ends_when_explored():
+    """seed 1.2.2 / 3.3.2: pits found across the way to the target refute it (no route is left): the next
+    frontier is taken at once; once that end is explored too, nothing is left to explore."""
+    m = strip_map()
+    ft = FrontierTarget(exclude_m=0.5, progress_m=0.3, patience_s=40.0)
+    ft.route(m, 1.5, 1.0, 0.0, reached_m=0.2, min_size=3)
+    left = ft.target
+    for k in range(9):                                   # a foot finds no ground across the strip at x = 1.0
+        m.grid.mark_barrier(1.0, 0.6 + 0.1 * k)
+    m.rebuild()
+    route = ft.route(m, 1.5, 1.0, 5.0, reached_m=0.2, min_size=3)
+    assert ft.given_up == [left] and ft.target is not None and ft.target[0] > 3.5
+    assert route and all(p[0] > 1.0 for p in route)                                    # never through the pits
+    for k in range(131):                                 # all seen: walls round x 0..6.5, y -0.5..2.5 ...
+        m.grid.mark_barrier(0.05 * k, -0.5)
+        m.grid.mark_barrier(0.05 * k, 2.5)
+    for k in range(61):
+        m.grid.mark_barrier(0.0, -0.5 + 0.05 * k)
+        m.grid.mark_barrier(6.5, -0.5 + 0.05 * k)
+    for i in range(64):                                  # ... and free inside (pits stay pits)
+        for j in range(29):
+            m.grid.mark_free(0.05 + 0.1 * i, -0.45 + 0.1 * j, 0.05)
+    m.rebuild()
+    assert not m.frontier_near(*ft.target, 0.5)
+    assert ft.route(m, 4.0, 1.0, 10.0, reached_m=0.2, min_size=3) == [] and ft.target is None
+
+
+def test_a_route_out_of_a_ring_of_pits_takes_its_one_gap():
+    """pit_ring's ring (scenarios/open/pit_ring.yaml) as the feet found it: from the start at its centre
+    the route to a point outside leaves through the 0.8 m gap on the east side, whatever side the goal is on."""
+    room = box(0, 0, 6, 4)
+    m = TopoMap(OccupancyGrid(-0.5, -0.5, 7.0, 5.0, 0.1), robot_radius_m=0.16, place_spacing_m=0.5)
+    for pose in ((3.0, 2.0, 90), (1.0, 0.5, 0), (5.0, 3.5, 0)):
+        m.add_scan(scan(room, *pose))
+    edge = 0.05
+    for k in range(int(2.8 / edge) + 1):                 # the ring's inner edges, as the feet found them
+        x = 1.6 + 0.4 + k * edge * (2.0 / 2.8)
+        m.grid.mark_barrier(x, 1.0)                      # south
+        m.grid.mark_barrier(x, 3.0)                      # north
+    for k in range(int(2.0 / edge) + 1):
+        y = 1.0 + k * edge
+        m.grid.mark_barrier(2.0, y)                      # west
+        if not 1.6 < y < 2.4:
+            m.grid.mark_barrier(4.0, y)                  # east, but for the gap
+    m.rebuild()
+    for goal in ((0.8, 2.0), (3.0, 0.4), (5.2, 2.0)):
+        route = m.route((3.0, 2.0), goal)
+        assert route is not None and route[-1] == goal
+        legs = list(zip([(3.0, 2.0)] + route, route))
+        out = [(a, b) for a, b in legs if (2.0 < a[0] < 4.0 and 1.0 < a[1] < 3.0)
+               != (2.0 < b[0] < 4.0 and 1.0 < b[1] < 3.0)]
+        assert len(out) == 1 and out[0][1][0] >= 4.0 and 1.6 < (out[0][0][1] + out[0][1][1]) / 2 < 2.4
+    for k in range(9):                                   # the gap found too: no way out
+        m.grid.mark_barrier(4.0, 1.6 + 0.1 * k)
+    m.rebuild()
+    assert m.route((3.0, 2.0), (5.2, 2.0)) is None
+
+
+def test_occupied_near_lists_the_occupied_cells_within_the_radius():
+    g = OccupancyGrid(0.0, 0.0, 4.0, 4.0, 0.1)
+    g.integrate(Reading(1.0, 2.0, 0.0, 0.0, 0.8))             # an echo 0.8 m east of (1, 2)
+    g.mark_barrier(1.0, 3.5)                                   # a pit edge 1.5 m north
+    near = g.occupied_near(1.0, 2.0, 1.0)
+    assert len(near) == 1 and abs(near[0][0] - 1.85) < 0.11 and abs(near[0][1] - 2.0) < 0.1
+    assert any(abs(y - 3.55) < 0.1 for _x, y in g.occupied_near(1.0, 2.0, 1.6))

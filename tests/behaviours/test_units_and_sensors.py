@@ -4,7 +4,7 @@ The JAC is tested in test_jac.py."""
 from __future__ import annotations
 
 from arachnae_proto import messages as M
-from arachnae_proto.enums import RangeStatus, TpscContact
+from arachnae_proto.enums import IscAxis, RangeStatus, TpscContact
 
 from behaviours.units import XMIT_DATA_OF, quantizer
 from tests.behaviours.rig import Rig
@@ -37,6 +37,25 @@ def test_each_sensor_answers_xmit_data_with_its_own_record_from_the_spec(spec):
     for role, cls in XMIT_DATA_OF.items():
         assert cls.RECORD and cls.SENDERS == (role,) and cls is not M.XmitData
     assert M.FETCHED_RECORDS[M.XmitGrant]["UIC_RCP"] == (M.Move, M.PostReq)     # longest first
+
+
+def test_record_values_and_alarm_thresholds_are_the_spec_s():
+    """seed 3.2.2, 6.2: each sensor's data record names the fields its records carry (spec record_values), the SPU
+    splits a reply into channels by it and the NP3 decodes with its encoding; each SET_ALARM threshold names the
+    record values it is compared with (a field's compared_with)."""
+    from behaviours.np3 import decode
+    from behaviours.spu import channels
+    assert {role: r.message for role, r in M.RECORD_VALUES.items()} == XMIT_DATA_OF
+    assert channels("IRRC", M.XmitDataIrrc(left=10, center=20, right=30)) == {0: 10, 1: 20, 2: 30}   # beam: position
+    assert channels("USRC", M.XmitDataUsrc(distance=7, angle=270)) == {270: 7}                      # head angle field
+    assert channels("ISC", M.XmitDataIsc(longitudinal=-5, transverse=3)) == {
+        int(IscAxis.LONGITUDINAL): -5, int(IscAxis.TRANSVERSE): 3}
+    assert channels("TPSC", M.XmitDataTpsc(contact=int(TpscContact.OBJ_BOTH))) == {0: int(TpscContact.OBJ_BOTH)}
+    assert decode("IRRC", 255) == 10.0 and decode("ISC", 256 - 5) == -5.0       # signed fields: two's complement
+    set_alarm = {cls for cls in M.MESSAGES if cls.SEED_NAME == "SET_ALARM"}
+    assert {a.message for a in M.ALARM_THRESHOLDS.values()} == set_alarm
+    for role, a in M.ALARM_THRESHOLDS.items():
+        assert a.message.RECEIVERS == (role,) and a.data is M.RECORD_VALUES[role] and a.limit == "limit"
 
 
 def test_tpsc_initiates_with_data_rdy_and_reports_the_whisker(spec):

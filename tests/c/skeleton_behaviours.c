@@ -29,7 +29,15 @@ void tpsc_on_status_req(tpsc_node *node, const arachnae_header *h, arachnae_stat
     (void)h;
     reply->status = ARACHNAE_ORDER_STATUS_IN_ORDER; /* seed 3.2.12: the TPSC always answers IN_ORDER */
 }
-void tpsc_on_xmit_data(tpsc_node *node, const arachnae_header *h) { (void)node; printf("call tpsc_on_xmit_data src=%u\n", h->src); }
+/* the first call answers OBJ_LEFT, every later one a reserved bit (0x01): the skeleton must refuse to send that */
+uint8_t tpsc_on_xmit_data(tpsc_node *node, const arachnae_header *h, arachnae_xmit_data_tpsc_t *reply)
+{
+    static uint8_t calls;
+    (void)node;
+    printf("call tpsc_on_xmit_data src=%u\n", h->src);
+    reply->contact = calls++ ? 0x01u : ARACHNAE_TPSC_CONTACT_OBJ_LEFT;
+    return 1;
+}
 
 /* ---- JAC (seed 3.2.18) ---- */
 void jac_send(jac_node *node, const uint8_t *frame, uint16_t len) { (void)node; print_frame("jac", frame, len); }
@@ -69,7 +77,14 @@ void mmc_on_status_ack_order(mmc_node *node, const arachnae_header *h, const ara
     (void)node;
     printf("call mmc_on_status_ack_order src=%u status=%u\n", h->src, msg->status);
 }
-void mmc_on_post_query(mmc_node *node, const arachnae_header *h) { (void)node; printf("call mmc_on_post_query src=%u\n", h->src); }
+/* POST not done yet: no reply now (seed 6.3; the behaviour sends POST_REPORT when it is) */
+uint8_t mmc_on_post_query(mmc_node *node, const arachnae_header *h, arachnae_post_report_t *reply)
+{
+    (void)node;
+    (void)reply;
+    printf("call mmc_on_post_query src=%u\n", h->src);
+    return 0;
+}
 void mmc_on_post_report(mmc_node *node, const arachnae_header *h, const arachnae_post_report_t *msg)
 {
     (void)node;

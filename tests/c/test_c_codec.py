@@ -309,7 +309,12 @@ def test_skeleton_dispatch_and_replies(spec, tmp_path):
         ("tpsc", F(a["TPSC"], a["SPU"], "STATUS_REQ", []), "OK",
          [f"send tpsc {hexf(a['SPU'], a['TPSC'], 'STATUS_ACK_ORDER', [enum['ORDER_STATUS'].values['IN_ORDER']])}"]),
         ("tpsc", F(bc, a["SPU"], "INIT", []), "OK", [f"call tpsc_on_init src={a['SPU']}"]),
-        ("tpsc", F(a["TPSC"], a["SPU"], "XMIT_DATA", []), "OK", [f"call tpsc_on_xmit_data src={a['SPU']}"]),
+        # seed 3.2.11: XMIT_DATA answered with XMIT_DATA_TPSC (spec reply_to) as the behaviour filled it (OBJ_LEFT)
+        ("tpsc", F(a["TPSC"], a["SPU"], "XMIT_DATA", []), "OK",
+         [f"call tpsc_on_xmit_data src={a['SPU']}",
+          f"send tpsc {hexf(a['SPU'], a['TPSC'], 'XMIT_DATA_TPSC', [spec.flags['TPSC_CONTACT'].bits['OBJ_LEFT']])}"]),
+        # the second time it fills a reserved bit: not sent, RANGE from dispatch (the parser passed the request)
+        ("tpsc", F(a["TPSC"], a["SPU"], "XMIT_DATA", []), "RANGE", [f"call tpsc_on_xmit_data src={a['SPU']}"], "OK"),
         # a message the role does not receive
         ("tpsc", F(a["TPSC"], a["SPU"], "MOVE_RELAYED", [2, 0x10]), "OPCODE", []),
         ("tpsc", F(a["IRRC"], a["SPU"], "ID_REQ", []), "ADDRESS", []),
@@ -334,15 +339,18 @@ def test_skeleton_dispatch_and_replies(spec, tmp_path):
          [f"call mmc_on_leg_report src={a['LCP(3)']} flags=1 x=10 y=-20 z=-1500 servo_temp=40"]),
         ("mmc", F(a["MMC"], a["MCP"], "MOVE_RELAYED", [a["NP3"], 0x10], None, 0x0100), "CHECKSUM", []),
         ("mmc", F(a["MMC"], a["LCP(2)"], "ID_ACK", [a["LCP(2)"]]), "OK", [f"call mmc_on_id_ack src={a['LCP(2)']} address={a['LCP(2)']}"]),
+        # the behaviour says its POST is not done: no POST_REPORT now
+        ("mmc", F(a["MMC"], a["MCP"], "POST_QUERY", []), "OK", [f"call mmc_on_post_query src={a['MCP']}"]),
     ]
-    (tmp_path / "in.txt").write_text("".join(f"{role} {fr.hex()}\n" for role, fr, _, _ in cases))
+    (tmp_path / "in.txt").write_text("".join(f"{role} {fr.hex()}\n" for role, fr, *_ in cases))
     res = run(exe, str(tmp_path / "in.txt"))
     assert res.returncode == 0, res.stderr.decode()
     expected = []
-    for role, fr, status, effects in cases:
-        # the parser with the role's buffer size and check agrees with the skeleton's verdict, except that a
-        # frame larger than anything the role receives is already refused as OVERSIZE
-        expected.append(f"parser {'OVERSIZE' if len(fr) > rx_max[role.upper()] else status}")
+    for role, fr, status, effects, *parser in cases:
+        # the role's parser (and the generic one with the role's buffer size and check: they agree) gives the
+        # skeleton's verdict, except that a frame larger than anything the role receives is already refused as
+        # OVERSIZE, and a reply the behaviour filled out of range (RANGE from dispatch, the request passed)
+        expected.append(f"parser {parser[0] if parser else 'OVERSIZE' if len(fr) > rx_max[role.upper()] else status}")
         expected.extend(effects)
         expected.append(f"status {status}")
     jacs = " ".join(f"{n.address:02x}" for n in spec.role_nodes("JAC"))
@@ -363,15 +371,21 @@ def test_linker_drops_what_a_role_does_not_use(spec, tmp_path):
         if m.name.lower() not in used:
             assert not present, f"{m.name} code linked into the TPSC image"
     # the skeleton writes ID_ACK's one byte itself: no ID_ACK function, nor the whole-frame check (the parser
-    # inlines its envelope check), is linked (issue 15)
+    # inlines its envelope check), nor the generic parser (the role has its own), is linked (issue 15)
     assert not any(n.startswith("arachnae_id_ack_") for n in names) and "tpsc_dispatch" in names
-    assert "arachnae_frame_check" not in names and "arachnae_parser_feed" in names
+    # its replies (STATUS_ACK_ORDER, XMIT_DATA_TPSC) are checked and packed inline: none of their functions either
+    assert not any(n.startswith(("arachnae_status_ack_order_", "arachnae_xmit_data_tpsc_")) for n in names)
+    assert "arachnae_frame_check" not in names and "tpsc_rx_feed" in names
+    assert not any(n.startswith("arachnae_parser_") for n in names)
     assert not any(n.startswith("arachnae_log10_") for n in names)
     assert "arachnae_messages" not in names  # the reflection layer stays out
     # and it works: ID_REQ in, ID_ACK out
     a = {n.short: n.address for n in spec.nodes}
     res = run(exe, stdin=dev_vectors.frame(a["TPSC"], a["SPU"], "ID_REQ", []))
     assert res.stdout == dev_vectors.frame(a["SPU"], a["TPSC"], "ID_ACK", [a["TPSC"]])
+    # XMIT_DATA in, XMIT_DATA_TPSC out (the skeleton's reply path, spec reply_to)
+    res = run(exe, stdin=dev_vectors.frame(a["TPSC"], a["SPU"], "XMIT_DATA", []))
+    assert res.stdout == dev_vectors.frame(a["SPU"], a["TPSC"], "XMIT_DATA_TPSC", [spec.flags["TPSC_CONTACT"].bits["OBJ_BOTH"]])
 
 
 def test_builds_for_avr_with_16_bit_int(tmp_path):

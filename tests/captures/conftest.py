@@ -87,5 +87,10 @@ def hostile_spec(tmp_path, repo):
     assert line in text
     doc = 'end ]] os.exit(1) --[[ """ \'\'\''
     hostile = line.replace("unit: V,", f"unit: {json.dumps(HOSTILE_UNIT)}, doc: {json.dumps(doc)},")
-    (spec_dir / "messages.yaml").write_text(text.replace(line, hostile))
+    text = text.replace(line, hostile)
+    # SET_ALARM_PSC's limit is compared with that voltage (compared_with), and the lint wants one unit for both
+    limit = '{name: limit, type: uint, bits: 8, unit: V, scale: "1/200", offset: 4, range: [4.2, 5.0], compared_with: XMIT_DATA_PSC}'
+    assert limit in text
+    text = text.replace(limit, limit.replace("unit: V,", f"unit: {json.dumps(HOSTILE_UNIT)},"))
+    (spec_dir / "messages.yaml").write_text(text)
     return load_spec(spec_dir)

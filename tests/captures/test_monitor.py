@@ -16,6 +16,7 @@ from collections import Counter
 from pathlib import Path
 
 import pytest
+from arachnae_proto.network import BUSES
 
 from arachnae.cli import main
 from captures.decode import decode
@@ -95,7 +96,7 @@ def test_replay_onto_a_pty_arrives_decoded_byte_identical_and_in_order(bus_run, 
 
     # the monitor's own capture: one interface for the bus, every frame's bytes in order
     cap = read_file(rec)
-    assert [(i.name, i.speed_bps) for i in cap.interfaces] == [(BUS, 9600)]
+    assert [(i.name, i.speed_bps) for i in cap.interfaces] == [(BUS, BUSES[BUS].baud)]
     assert [f.data for f in cap.frames] == [f.data for f in sent]
     assert [f.time_ns for f in cap.frames] == sorted(f.time_ns for f in cap.frames)
     # issue 11: the trace validator reads the monitor's capture as it reads a run's trace. A pty's time stamps

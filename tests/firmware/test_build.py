@@ -43,7 +43,9 @@ def test_images_link_only_the_roles_messages(firmware_built, spec):
         present = any(f" arachnae_{name}_{fn}" in syms for fn in ("validate", "build", "decode", "encode"))
         if name not in used:
             assert not present, f"{m.name} linked into the TPSC image"
-    assert " arachnae_xmit_data_tpsc_build" in syms
+    # the positive side: DATA_RDY, which the TPSC sends on its own, is built through its _build; its XMIT_DATA_TPSC
+    # reply is checked and packed inline by the skeleton (spec reply_to, issue 15), so its _build is not linked
+    assert " arachnae_data_rdy_build" in syms and " arachnae_xmit_data_tpsc_build" not in syms
 
 
 def test_no_image_allocates(firmware_built, spec):

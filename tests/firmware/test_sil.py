@@ -2,12 +2,19 @@
 from __future__ import annotations
 
 import pytest
+from arachnae_proto.enums import OrderStatus, RangeStatus, TpscContact
+from arachnae_proto.network import ADDRESS_OF, BUSES, NODES
 
 from tests.firmware.conftest import REPO
 
 F = 16_000_000
 MS = F // 1000
-CHAR_2400 = F * 10 // 2400
+# the spec's addresses and sensor bus (seed 3.2.1), not literals: every fixture here is a sensor-bus slave,
+# and sil/echo.c runs at that bus's rate too (the TPSC's build configuration)
+TPSC, IRRC, LSC = ADDRESS_OF["TPSC"], ADDRESS_OF["IRRC"], ADDRESS_OF["LSC"]
+SENSOR_BUS_INFO = BUSES[NODES[TPSC].bus]
+SPU = ADDRESS_OF[SENSOR_BUS_INFO.master]
+CHAR = F * SENSOR_BUS_INFO.bits_per_char // SENSOR_BUS_INFO.baud     # cycles per character
 
 
 @pytest.fixture
@@ -42,7 +49,7 @@ def run_like_the_bridge(host, until: int) -> list:
 def send(host, data: bytes):
     start = host.cycle
     for i, b in enumerate(data):
-        host.inject(start + i * CHAR_2400, b)
+        host.inject(start + i * CHAR, b)
 
 
 def test_echo_firmware_answers_one_character_time_after_each_byte(host_factory):
@@ -52,8 +59,8 @@ def test_echo_firmware_answers_one_character_time_after_each_byte(host_factory):
     ev = h.run_until(60 * MS)
     (t,) = [e for e in ev if e[0] == "t"]
     assert t[2] == 0x42
-    # RXC comes one (simavr) character time after the byte entered: 11 bits at 2400 baud
-    assert 0.9 * CHAR_2400 < t[1] - 2 * MS < 1.2 * CHAR_2400
+    # RXC comes one (simavr) character time after the byte entered: 11 bits at the bus's rate
+    assert 0.9 * CHAR < t[1] - 2 * MS < 1.2 * CHAR
     de = [(e[1], e[3]) for e in ev if e[0] == "p" and e[2] == "D2"]
     assert de[-2][1] == 1 and de[-1][1] == 0 and de[-2][0] < t[1] < de[-1][0]
 
@@ -65,15 +72,15 @@ def test_tpsc_firmware_answers_id_req_and_status_req_like_the_python_codec(host_
         h.set_pin(pin, 1)
     h.set_pin("C2", 0)
     h.run_until(50 * MS)
-    send(h, frame.build(0x28, 0x04, messages.IdReq()))
+    send(h, frame.build(TPSC, SPU, messages.IdReq()))
     out = tx_bytes(h.run_until(h.cycle + 80 * MS))
-    assert out == frame.build(0x04, 0x28, messages.IdAck(address=0x28))
-    send(h, frame.build(0x28, 0x04, messages.StatusReq()))
+    assert out == frame.build(SPU, TPSC, messages.IdAck(address=TPSC))
+    send(h, frame.build(TPSC, SPU, messages.StatusReq()))
     out = tx_bytes(h.run_until(h.cycle + 80 * MS))
-    assert frame.parse(out).message == messages.StatusAckOrder(status=0)   # seed 3.2.12: always IN_ORDER
+    assert frame.parse(out).message == messages.StatusAckOrder(status=int(OrderStatus.IN_ORDER))   # seed 3.2.12: always
     # a request to another node, and one with a bad checksum, get no answer
-    send(h, frame.build(0x29, 0x04, messages.IdReq()))
-    bad = bytearray(frame.build(0x28, 0x04, messages.IdReq()))
+    send(h, frame.build(IRRC, SPU, messages.IdReq()))
+    bad = bytearray(frame.build(TPSC, SPU, messages.IdReq()))
     bad[-1] ^= 1
     h.run_until(h.cycle + 60 * MS)
     send(h, bytes(bad))
@@ -93,7 +100,7 @@ def test_tpsc_initiates_and_resends_after_a_corrupt_echo(host_factory, spec):
     ev, limit = [], h.cycle + 100 * MS
     while not any(e[0] == "p" and e[2] == "D2" and e[3] == 0 for e in ev) and h.cycle < limit:
         ev += h.run(limit)                              # stops at every byte and pin change
-    assert tx_bytes(ev) == frame.build(0x04, 0x28, messages.DataRdy())
+    assert tx_bytes(ev) == frame.build(SPU, TPSC, messages.DataRdy())
     released = next(e[1] for e in ev if e[0] == "p" and e[2] == "D2" and e[3] == 0)
     assert any(e[0] == "p" and e[2] == "B5" and e[3] == 1 for e in ev)   # stimulus test point
     from firmware.sil_bridge import hal_enum
@@ -101,19 +108,19 @@ def test_tpsc_initiates_and_resends_after_a_corrupt_echo(host_factory, spec):
     h.set_pin("C2", 1)                                  # the line released: the bus reports a corrupt echo
     ev = run_like_the_bridge(h, h.cycle + 150 * MS)
     again = [e for e in ev if e[0] == "t"]
-    assert tx_bytes(ev) == frame.build(0x04, 0x28, messages.DataRdy())    # resent once, then its echo is good
+    assert tx_bytes(ev) == frame.build(SPU, TPSC, messages.DataRdy())    # resent once, then its echo is good
     from behaviours.netconfig import NetConfig
     from behaviours.runtime import BusTiming, arbitration_rank, slave_quiet
-    net, t = NetConfig.from_spec(spec), BusTiming("sensor")
-    rank = arbitration_rank(net, "sensor", 0x28)                          # spec rank_order
+    net, t = NetConfig.from_spec(spec), BusTiming(NODES[TPSC].bus)
+    rank = arbitration_rank(net, NODES[TPSC].bus, TPSC)                   # spec rank_order
     quiet_ms = (again[0][1] - released) / MS
     # Runtime._slave_start inside the window after our corrupt frame: the line quiet for the window's idle
     # time, and the reflex source (rank 0) resends in the first slot of the window, which starts as our frame ends
     assert rank == 0
     assert slave_quiet(t, net, rank, True).in_window * 1e3 < quiet_ms < net.backoff_slots * t.slot_s * 1e3, quiet_ms
-    send(h, frame.build(0x28, 0x04, messages.XmitData()))
+    send(h, frame.build(TPSC, SPU, messages.XmitData()))
     out = tx_bytes(run_like_the_bridge(h, h.cycle + 80 * MS))
-    assert frame.parse(out).message == messages.XmitDataTpsc(contact=0x20)   # OBJ_RIGHT
+    assert frame.parse(out).message == messages.XmitDataTpsc(contact=int(TpscContact.OBJ_RIGHT))
     assert 0 < h.stack_used() < 256
 
 
@@ -201,14 +208,16 @@ def test_irrc_firmware_three_plus_three_rule_declares_itself_unreliable(host_fac
         return None
     ev = answer_port(h, h.cycle + 100 * MS, spread)
     notes = [e for e in ev if e[0] == "a" and e[2] == status_note]
-    assert [e[3] for e in notes] == [2]               # UNRELIABLE, once
-    send(h, frame.build(0x29, 0x04, messages.StatusReq()))
+    assert [e[3] for e in notes] == [int(RangeStatus.UNRELIABLE)]     # once
+    send(h, frame.build(IRRC, SPU, messages.StatusReq()))
     out = tx_bytes(answer_port(h, h.cycle + 120 * MS, spread))
     # the DATA_RDY announcing the change may come first; the reply to STATUS_REQ is the last frame
-    assert frame.parse(out[-7:]).message == messages.StatusAckRange(status=2)
-    send(h, frame.build(0x29, 0x04, messages.XmitData()))
+    want = frame.build(SPU, IRRC, messages.StatusAckRange(status=int(RangeStatus.UNRELIABLE)))
+    assert out[-len(want):] == want
+    send(h, frame.build(IRRC, SPU, messages.XmitData()))
     out = tx_bytes(answer_port(h, h.cycle + 120 * MS, spread))
-    assert frame.parse(out[-9:]).message == messages.XmitDataIrrc(left=100, center=101, right=100)
+    want = frame.build(SPU, IRRC, messages.XmitDataIrrc(left=100, center=101, right=100))
+    assert out[-len(want):] == want
 
 
 def test_lsc_firmware_sends_the_mean_of_the_last_three_readings(host_factory):
@@ -223,7 +232,7 @@ def test_lsc_firmware_sends_the_mean_of_the_last_three_readings(host_factory):
     def reply(code, arg):
         return [next(seq)] if code == light else None
     answer_port(h, 850 * MS, reply)                    # readings at 0, 200, 400, 600, 800 ms
-    send(h, frame.build(0x2C, 0x04, messages.XmitData()))
+    send(h, frame.build(LSC, SPU, messages.XmitData()))
     out = tx_bytes(answer_port(h, h.cycle + 100 * MS, reply))
     assert frame.parse(out).message == messages.XmitDataLsc(brightness=round((40 + 70 + 90) / 3))
 
@@ -265,7 +274,7 @@ def test_irrc_firmware_alarm_fires_once_per_crossing_and_rearms_with_hysteresis(
     def reply(code, arg):
         return [255, level[0], 255] if code == ir else None
     answer_port(h, 60 * MS, reply)
-    send(h, frame.build(0x29, 0x04, messages.SetAlarmIrrc(limit=limit)))
+    send(h, frame.build(IRRC, SPU, messages.SetAlarmIrrc(limit=limit)))
     answer_port(h, h.cycle + 100 * MS, reply)
 
     def phase(value, ms=300):
@@ -274,7 +283,7 @@ def test_irrc_firmware_alarm_fires_once_per_crossing_and_rearms_with_hysteresis(
         return [e[3] for e in ev if e[0] == "a" and e[2] == alarm], tx_bytes(ev)
     fired, out = phase(limit - 1)
     assert fired == [0b010]                                  # the centre beam, once
-    assert frame.build(0x04, 0x29, messages.DataRdy()) in out  # announced on its own
+    assert frame.build(SPU, IRRC, messages.DataRdy()) in out  # announced on its own
     assert phase(limit - 20)[0] == []                        # still beyond: no second alarm
     assert phase(limit + rearm - 1)[0] == []                 # back, but not far enough to re-arm
     assert phase(limit - 1)[0] == []

@@ -15,7 +15,8 @@ import pytest
 from tests.hostile.spec_harness import M, N, compile_c, generate, import_python, refused_everywhere, replace, spec_copy
 
 OBJ_BOTH_DOC = 'doc: "Both whiskers touched together."}'
-VOLTAGE_UNIT = "{name: voltage, type: uint, bits: 8, unit: V,"
+# a unit no threshold is compared with (a SET_ALARM limit shares its data's unit, codegen/lint.py _lint_compared)
+CURRENT_UNIT = "{name: current, type: uint, bits: 16, unit: mA,"
 CRC_NAME = "name: CRC-16/IBM-3740"
 SSC_TEXT = 'MALFUNCTION: "Malfunction"'
 
@@ -32,8 +33,8 @@ ACCEPTED = [
     ("control_and_non_ascii", M, OBJ_BOTH_DOC, r'doc: "30 \u00b0C\t\0\x1b[2J \u2028 \U0001F577"}',
      DOC, "30 \u00b0C\t\0\x1b[2J \u2028 \U0001F577"),
     ("jinja_looking_text", M, OBJ_BOTH_DOC, 'doc: "{{ spec.hash }} {% raw %} {#"}', DOC, "{{ spec.hash }} {% raw %} {#"),
-    ("unit_with_quotes_and_terminators", M, VOLTAGE_UNIT, r'{name: voltage, type: uint, bits: 8, unit: "*/ \"V\" \\",',
-     "M.XmitDataPsc.FIELDS[0].unit", '*/ "V" \\'),
+    ("unit_with_quotes_and_terminators", M, CURRENT_UNIT, r'{name: current, type: uint, bits: 16, unit: "*/ \"mA\" \\",',
+     "next(f.unit for f in M.JointFeedback.FIELDS if f.name == 'current')", '*/ "mA" \\'),
     ("checksum_name", M, CRC_NAME, r'name: "CRC \" */ \\"', "__import__('arachnae_proto.frame').frame.CRC_NAME", 'CRC " */ \\'),
     ("enum_text", M, SSC_TEXT, r'MALFUNCTION: "\"\"\" \\"',
      "__import__('arachnae_proto.enums').enums.SSC_MESSAGE_TEXTS[1]", '""" \\'),

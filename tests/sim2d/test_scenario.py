@@ -76,6 +76,9 @@ def test_include_cycle_and_missing_include(write):
 def test_missing_required_key_and_bad_yaml(write):
     with pytest.raises(UserError, match="missing required key 'robot'"):
         load_scenario(write("s.yaml", "duration: 1\narena: {size: [1, 1]}\n"))
+    with pytest.raises(UserError) as err:          # every missing key, once, in one line (arachnae.validation)
+        load_scenario(write("s.yaml", "duration: 1\n"))
+    assert str(err.value).endswith("s.yaml:1: (top level): missing required keys 'arena', 'robot'"), err.value
     with pytest.raises(UserError, match=r"s\.yaml:2: .*invalid YAML"):
         load_scenario(write("s.yaml", "duration: 1\narena: {size: [1, 1]}}\nrobot: {}\n"))
 

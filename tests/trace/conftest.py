@@ -8,11 +8,13 @@ from pathlib import Path
 import pytest
 
 # PSC (optional, sensor bus) and LCP(1) with its leg's JACs are not fitted: POST is DEGRADED, and the
-# masters' ID_REQ retries and timeouts to the missing nodes are on the wire
+# masters' ID_REQ retries and timeouts to the missing nodes are on the wire; the operator's halt key puts a
+# MOVE_RELAYED on the first-level bus (an idle NP3 sends no MOVE after POST)
 MISSING = """name: missing
 duration: 3
 arena: {size: [4, 3]}
 robot: {pose: [2, 1.5, 0], task: idle, absent: [PSC, "LCP(1)"]}
+operator: [{at: 2.0, keys: H}]
 expect: {post: DEGRADED}
 """
 

@@ -316,6 +316,7 @@ class RoleView:
     status_req: MessageView | None = None
     status_ack: MessageView | None = None
     others: list[MessageView] = field(default_factory=list)
+    replies: dict[str, MessageView] = field(default_factory=dict)   # request name -> its reply (reply_to), others only
 
     @property
     def node_t(self) -> str:
@@ -324,6 +325,20 @@ class RoleView:
     @property
     def guard(self) -> str:
         return f"ARACHNAE_NODE_{self.role.upper()}_H"
+
+    @property
+    def multi_address(self) -> bool:
+        """More than one node has this role: its parser keeps the own address (node_<role>.h)."""
+        return len(self.nodes) > 1
+
+    @property
+    def rx_count_t(self) -> str:
+        """Type of the role parser's byte count: 8 bits where the role's largest frame allows (AVR flash)."""
+        return "uint8_t" if self.rx_max <= 0xFF else "uint16_t"
+
+    @property
+    def rx_init(self) -> str:
+        return f"{self.role.upper()}_RX_INIT"
 
     @property
     def empty_receives(self) -> list[MessageView]:
@@ -340,8 +355,18 @@ class RoleView:
         return [m for m in self.receives if m.has_fields]
 
     @property
+    def answers(self) -> bool:
+        """The skeleton answers some request itself (one reply buffer, one seal, one send)."""
+        return bool(self.id_req or self.status_req or self.replies)
+
+    @property
+    def reply_has_array(self) -> bool:
+        """Some reply is checked and packed through its functions (an array: not inlined)."""
+        return any(m.array for m in [self.status_ack, *self.replies.values()] if m is not None)
+
+    @property
     def reply_max(self) -> int:
-        return max([m.frame_max for m in (self.id_ack, self.status_ack) if m is not None] or [0])
+        return max([m.frame_max for m in (self.id_ack, self.status_ack, *self.replies.values()) if m is not None] or [0])
 
 
 @dataclass
@@ -505,6 +530,14 @@ def view(spec: Spec) -> dict:
                     raise N.Unsupported(rv.status_ack.origin, "a STATUS_ACK needs a field for the C skeleton to fill")
             else:
                 rv.others.append(mv)
+                # seed 3.2.2: a request this role answers (spec reply_to) is answered through the skeleton's reply path
+                answer = spec.reply(mv.name, role)
+                if answer is not None:
+                    rep = by_name[answer.name]
+                    if mv.has_fields or not rep.has_fields:
+                        raise N.Unsupported(rep.origin, f"the C skeleton answers {mv.name} only as an empty request "
+                                                        "with a reply that has fields (its decoded request and reply share node->msg)")
+                    rv.replies[mv.name] = rep
         roles.append(rv)
 
     return {

@@ -102,6 +102,13 @@ def identifiers(spec: Spec, vm: dict) -> Iterator[N.Ident]:
             yield N.Ident(SCOPE, f"{rv.lname}_on_{mv.lname}", N.of_message(spec, mv.m))
         for mv in rv.field_others:
             yield N.Ident(f"the C union {rv.node_t}.msg", f"rx_{mv.lname}", N.of_message(spec, mv.m))
+        for mv in rv.others:
+            if mv.name in rv.replies:
+                yield N.Ident(f"the C union {rv.node_t}.msg", f"reply_{mv.lname}", N.of_message(spec, mv.m))
+        # the role's own byte parser (parser.j2)
+        yield N.Ident(SCOPE, rv.rx_init, at)
+        for suffix in ("rx", "rx_feed", "rx_gap", "rx_frame"):
+            yield N.Ident(SCOPE, f"{rv.lname}_{suffix}", at)
         for suffix in (".h", ".c"):
             yield N.Ident("the generated C files", f"node_{rv.lname}{suffix}", at, is_file=True)
     for mv in vm["messages"]:

@@ -234,8 +234,14 @@ def outputs(spec: Spec) -> list[Output]:
             by_role = fetched.setdefault(camel(bus.fetch_message), {})
             for role, records in spec.fetched_records(bus.name).items():
                 by_role.setdefault(role, [camel(m.name) for m in records])
+    # seed 3.2.2, 6.2: per sensor role, the fields its records carry (messages.<m>.record_values) and the threshold
+    # that is compared with them (a field's compared_with); the lint allows one of each per role
+    record_values = [{"role": m.senders[0], "cls": camel(m.name), "fields": m.record_values, "channel": m.record_channel}
+                     for m in spec.messages if m.record_values]
+    thresholds = [{"role": spec.message(f.compared_with).senders[0], "cls": camel(m.name), "limit": f.name}
+                  for m in spec.messages for f in m.fields if f.compared_with is not None]
     width = spec.frame.checksum.width
-    ctx = {"errors": ERROR_KINDS, "msgs": msgs, "fetched": fetched, "common": COMMON, "roles": roles, "tables": log_tables(spec), "crc_fast": crc_fast(spec), "routes": routes,
+    ctx = {"errors": ERROR_KINDS, "msgs": msgs, "fetched": fetched, "record_values": record_values, "thresholds": thresholds, "common": COMMON, "roles": roles, "tables": log_tables(spec), "crc_fast": crc_fast(spec), "routes": routes,
            "crc_shift": width - 8, "crc_top": 1 << (width - 1), "crc_mask": (1 << width) - 1}
     out = [
         Output("__init__.py", "init.py.j2", ctx),

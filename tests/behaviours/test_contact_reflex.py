@@ -1,0 +1,113 @@
+"""The contact reflex switched on next to walls (issue 17 item 5, seed 5.1.2, 5.2): whatever the wall's angle,
+or in a corner, its manoeuvre never sweeps the body into a wall and leaves the robot walking away from each.
+
+A small world of straight walls in the robot's start frame: the IR beams and the whiskers are cast onto
+them, the manoeuvre the reflex plans is followed with the speeds the NP3 assumes, and the body's corners
+are checked at every step."""
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import pytest
+
+from behaviours.np3_layers import Tuning, contact_trigger, velocity
+from behaviours import tuning as T
+from sim2d.robot_params import DEFAULT as P
+
+TUNING = Tuning()
+
+
+class Wall(NamedTuple):
+    normal_deg: float      # direction from the robot towards the wall, start frame (0 = straight ahead)
+    dist_m: float          # the start pose's distance to it
+
+
+def corners(x: float, y: float, th: float) -> list[tuple[float, float]]:
+    hl, hw = P.body_length / 2, P.body_width / 2
+    c, s = math.cos(th), math.sin(th)
+    return [(x + bx * c - by * s, y + bx * s + by * c) for bx in (hl, -hl) for by in (hw, -hw)]
+
+
+def depth(p: tuple[float, float], w: Wall) -> float:
+    """How far the point lies beyond the wall (> 0: inside it)."""
+    a = math.radians(w.normal_deg)
+    return p[0] * math.cos(a) + p[1] * math.sin(a) - w.dist_m
+
+
+def walls_at(normals_deg: tuple[float, ...], gap_m: float) -> list[Wall]:
+    """Walls with these normals, each gap_m from the body's nearest corner at the start pose."""
+    return [Wall(n, max(depth(c, Wall(n, 0.0)) for c in corners(0.0, 0.0, 0.0)) + gap_m) for n in normals_deg]
+
+
+def ray(origin: tuple[float, float], deg: float, reach: float, walls: list[Wall]) -> float | None:
+    ux, uy = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+    hits = []
+    for w in walls:
+        a = math.radians(w.normal_deg)
+        towards = ux * math.cos(a) + uy * math.sin(a)
+        if towards > 1e-9:
+            s = -depth(origin, w) / towards
+            if 0.0 <= s <= reach:
+                hits.append(s)
+    return min(hits, default=None)
+
+
+def sonar_echoes(walls: list[Wall]) -> tuple:
+    """What a sonar sweep from the body centre leaves in the echo memory: one point every 30 deg where a beam
+    meets a wall within 0.5 m (start frame = the dead-reckoned frame, pose (0, 0, 0))."""
+    out = []
+    for deg in range(-180, 180, 30):
+        d = ray((0.0, 0.0), deg, 0.5, walls)
+        if d is not None:
+            out.append((d * math.cos(math.radians(deg)), d * math.sin(math.radians(deg)), float(deg), 0.0))
+    return tuple(out)
+
+
+def sensed(walls: list[Wall]) -> dict:
+    """seed 3.2.12, 3.2.13: the three IR beams (10 cm) and the two whiskers at the start pose, and the echoes."""
+    front = (P.body_length / 2, 0.0)
+    ir = tuple(ray(front, deg, P.ir_range, walls) for deg in P.ir_beams_deg)
+    deg = math.degrees(P.whisker_angle)
+    left, right = (ray((P.body_length / 2, side * P.body_width / 2), side * deg, P.whisker_length, walls) is not None
+                   for side in (1.0, -1.0))
+    return {"ir": ir, "whisker": (1, left, right, 0.0), "pose": (0.0, 0.0, 0.0), "echoes": sonar_echoes(walls)}
+
+
+def follow(steps, walls: list[Wall], dt: float = 0.02) -> tuple[float, float]:
+    """Follow the plan from the start pose; (the deepest any body corner went into a wall, final heading)."""
+    x = y = th = 0.0
+    worst = -math.inf
+    for duration, cmd in steps:
+        vx, vy, w = velocity(cmd, TUNING)
+        for _ in range(int(round(duration / dt))):
+            x += (vx * math.cos(th) - vy * math.sin(th)) * dt
+            y += (vx * math.sin(th) + vy * math.cos(th)) * dt
+            th += w * dt
+            worst = max(worst, max(depth(c, wall) for c in corners(x, y, th) for wall in walls))
+    return worst, th
+
+
+CASES = {
+    "facing a wall": ((0.0,), 0.03),
+    "wall 30 deg to the left": ((30.0,), 0.03),
+    "wall 30 deg to the right": ((-30.0,), 0.03),
+    "wall 60 deg to the right": ((-60.0,), 0.03),
+    "pressed into a corner": ((45.0, -45.0), 0.03),
+    "corner, one wall square ahead": ((0.0, 90.0), 0.03),
+}
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_switched_on_next_to_walls_the_reflex_turns_away_without_touching(name):
+    normals, gap = CASES[name]
+    walls = walls_at(normals, gap)
+    seen = sensed(walls)
+    assert seen["whisker"][1] or seen["whisker"][2] or any(d is not None for d in seen["ir"])   # a real contact
+    steps = contact_trigger(TUNING)(seen, 0.0)
+    assert steps, f"{name}: no reaction to {seen}"
+    worst, heading = follow(steps, walls)
+    assert worst < 0.0, f"{name}: a body corner went {worst:.3f} m into a wall"
+    for w in walls:                                     # every wall behind the robot's side: it walks away
+        off = abs((math.degrees(heading) - w.normal_deg + 180.0) % 360.0 - 180.0)
+        assert off >= 90.0 + T.NP3_CONTACT_CLEAR_DEG / 2, f"{name}: heading {math.degrees(heading):.0f} deg, wall {w}"
