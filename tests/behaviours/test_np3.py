@@ -480,7 +480,25 @@ def test_a_wall_alongside_seen_off_the_axis_is_no_obstacle_ahead(spec):
     assert len(pts) == T.NP3_SONAR_CONE_POINTS and min(abs(p[1]) for p in pts) < 0.15    # inner edge in the way
     assert clear_ahead(pts, T.NP3_WALL_TARGET_M - T.NP3_WALL_DEADBAND_M) == math.inf
     before = len(node.echoes)
+    node.pings.clear()        # a case of its own: a wall 0.4 m ahead would have answered the first ping at its edge
     node.sonar_memory(Ping(1.1, 0.0, 0.0, 0.0, 0.4), 0.0)
     ahead = body_frame(tuple(e.point() for e in list(node.echoes)[before:]), (0.0, 0.0, 0.0))
     assert len(ahead) == T.NP3_SONAR_CONE_POINTS
     assert all(clear_ahead([p], T.NP3_AVOID_HALF_WIDTH_M) == pytest.approx(p[0]) for p in ahead)
+
+
+def test_the_ping_straight_ahead_clears_the_inner_edge_of_the_ping_15_deg_off(spec):
+    """issue 17 (corridor_narrow seeds 3, 4): walls 0.25 m either side, the ping 15 deg left puts the inner edge of
+    its cone 0.085 m off the axis 0.65 m ahead; the ping straight ahead, whose beam shares that edge and meets the
+    walls only 1.9 m on, shows it free. With a cone narrower than the beam it stayed in the legs' way."""
+    rig = np3(spec, task="idle")
+    rig.run(1.0)
+    node = rig.node
+    edge = math.radians(T.NP3_SONAR_BEAM_DEG / 2)
+    node.sonar_memory(Ping(1.0, 0.0, 0.0, math.radians(15), 0.25 / math.sin(math.radians(15) + edge)), 15.0)
+    band = Tuning().body_half_width_m + Tuning().guard_margin_m
+    assert min(abs(e.y) for e in node.echoes if e.sonar) < band
+    node.sonar_memory(Ping(1.6, 0.0, 0.0, 0.0, 0.25 / math.sin(edge)), 0.0)
+    left = [e for e in node.echoes if e.sonar]
+    assert left and min(abs(e.y) for e in left) > band
+    assert max(e.y for e in left) == pytest.approx(0.25, abs=0.01)     # the wall's point stays
