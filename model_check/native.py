@@ -46,6 +46,14 @@ from model_check.gcl import Model
 from model_check.storage import LOAD, StateStore
 
 CC_FLAGS = ("-O1", "-shared", "-fPIC", "-std=c99", "-w")
+# more compiler flags from the environment, for measurements and checks (e.g. "-DPSTAT": the
+# parallel search's phase timers printed at exit; "-fsanitize=address,undefined"); part of the cache key
+EXTRA_FLAGS_ENV = "ARACHNAE_NATIVE_CFLAGS"
+
+
+def cc_flags() -> tuple[str, ...]:
+    """CC_FLAGS and the environment's extra flags."""
+    return CC_FLAGS + tuple(os.environ.get(EXTRA_FLAGS_ENV, "").split())
 HIT_NONE, HIT_INVARIANT, HIT_DEADLOCK, HIT_RANGE, HIT_FULL = 0, 1, 2, 3, 4
 MAX_EDGES = 1 << 16       # edges per call at most: bounds the buffers (about 3 MB for 3-word states)
 
@@ -102,6 +110,7 @@ def _c(node: ast.expr, name) -> str:
 
 
 _PRELUDE = """\
+#define _GNU_SOURCE           /* syscall (the parallel search's futex), clock_gettime (PSTAT) */
 #include <stdint.h>
 #include <string.h>
 typedef int64_t I;
@@ -256,6 +265,11 @@ out:
 #   its edges, each candidate turned into its id, at their place in the store.
 _PARALLEL = """\
 #include <sched.h>
+#ifdef __linux__
+#include <linux/futex.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#endif
 typedef struct {
     int32_t *ev; RULE_T *er; uint8_t *crow; int32_t *cpar; U *chash; int64_t *cslot, *cstep;
     int32_t *clocal, *ltable, *cown, *cidx;
@@ -266,19 +280,44 @@ typedef struct {
     uint8_t *keys; int32_t *parent, *table, *dst; RULE_T *rules; uint16_t *degree;
     int64_t width, tbits, tlimit, kcap, ecap, dcap, nk, ne, i, workers, edges_max, narrow, fan,
             seen_states, seen_edges, rounds, status, cap, bcount, bsense, nrounds, nsplit, ndropped,
-            nslices, cexp, cmark, cins;
+            nslices, cexp, cmark, cins, bsleep;
     Res hit;
 } Ctx;
 enum { P_RUN, P_DONE, P_PAUSE, P_GROW, P_HIT };
+/* the threads meet: a short spin (a round's threads usually arrive within microseconds), then
+   a sleep on a futex (Linux; sched_yield elsewhere), so a thread waiting for one that other load
+   holds up gives its core away instead of spinning on it. bsense's low half is the futex word
+   (little-endian rows: Builder); bsleep counts the sleepers, so the last thread makes a wake
+   call only when one sleeps (its store and load, and a sleeper's count and the kernel's check
+   of the word, are sequentially consistent: no wake is lost). */
+#define SPIN 2000
+static inline void prelax(void) {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+}
 static void pbarrier(Ctx *c, int64_t *sense) {
     int64_t s = !*sense;
     *sense = s;
     if (__atomic_add_fetch(&c->bcount, 1, __ATOMIC_ACQ_REL) == c->workers) {
         __atomic_store_n(&c->bcount, 0, __ATOMIC_RELAXED);
-        __atomic_store_n(&c->bsense, s, __ATOMIC_RELEASE);
-    } else
-        for (int k = 0; __atomic_load_n(&c->bsense, __ATOMIC_ACQUIRE) != s; k++)
-            if (k > 100) sched_yield();
+        __atomic_store_n(&c->bsense, s, __ATOMIC_SEQ_CST);
+#ifdef __linux__
+        if (__atomic_load_n(&c->bsleep, __ATOMIC_SEQ_CST))
+            syscall(SYS_futex, (int32_t *)&c->bsense, FUTEX_WAKE_PRIVATE, INT32_MAX, NULL, NULL, 0);
+#endif
+        return;
+    }
+    for (int k = 0; __atomic_load_n(&c->bsense, __ATOMIC_ACQUIRE) != s; k++) {
+        if (k < SPIN) { prelax(); continue; }
+#ifdef __linux__
+        __atomic_add_fetch(&c->bsleep, 1, __ATOMIC_SEQ_CST);
+        syscall(SYS_futex, (int32_t *)&c->bsense, FUTEX_WAIT_PRIVATE, (int32_t)!s, NULL, NULL, 0);
+        __atomic_sub_fetch(&c->bsleep, 1, __ATOMIC_SEQ_CST);
+#else
+        sched_yield();
+#endif
+    }
 }
 static void pexpand(const Ctx *c, Slice *q) {
     int64_t tbits = c->tbits;
@@ -286,6 +325,7 @@ static void pexpand(const Ctx *c, Slice *q) {
     U succ[NRULES * W]; int32_t sr[NRULES];
     uint8_t tb[W * 8];
     const uint8_t *keys = c->keys;
+    const int32_t *table = c->table;
     int64_t ne = 0, nc = 0, i = q->a;
     Res *r = &q->r;
     r->kind = 0;
@@ -295,14 +335,15 @@ static void pexpand(const Ctx *c, Slice *q) {
         memcpy(s, keys + (size_t)i * KW, KW);      /* little-endian rows (Builder) */
         int64_t k = visit(s, succ, sr, r);
         if (k < 0) break;
+        SUCC_SLOTS();
         for (int64_t j = 0; j < k; j++) {
             const U *t = succ + (size_t)j * W;
-            HASH_SLOT();
+            U hh = hs_[j], slot = hh >> (64 - tbits);
             memcpy(tb, t, KW);
             int32_t got = -1;
             U step = 1;
             for (;; step++) {
-                int32_t g = c->table[slot];
+                int32_t g = table[slot];
                 if (g < 0) break;
                 if (keq(keys + (size_t)g * KW, tb)) { got = g; break; }
                 slot = (slot + step) & tmask;
@@ -365,14 +406,10 @@ static inline void pclaim(int32_t *table, U slot, U step, U tmask, int32_t id) {
     }
 }
 /* rehash's part lo .. hi-1 on one of several threads at once (the slot order may differ) */
+#define PPLACE(SLOT, ID) pclaim(table, (SLOT), 1, tmask, (ID))
 void prehash(const uint8_t *keys, int64_t lo, int64_t hi, int32_t *table, int64_t tbits) {
-    U tmask = ((U)1 << tbits) - 1, t[W];
-    for (int64_t i = lo; i < hi; i++) {
-        memset(t, 0, sizeof t);
-        memcpy(t, keys + (size_t)i * KW, KW);
-        HASH_SLOT();
-        pclaim(table, slot, 1, tmask, (int32_t)i);
-    }
+    U tmask = ((U)1 << tbits) - 1;
+    REHASH_LOOP(PPLACE);
 }
 static void pinsert(const Ctx *c, Slice *sl, int64_t t) {
     Slice *q = &sl[t];
@@ -452,30 +489,52 @@ static inline int64_t ptake(const Ctx *c, int64_t *next) {
     int64_t k = __atomic_fetch_add(next, 1, __ATOMIC_RELAXED);
     return k < c->nslices ? k : -1;
 }
+#ifdef PSTAT    /* phase timers (ARACHNAE_NATIVE_CFLAGS=-DPSTAT): wall and CPU ns per thread, printed at exit */
+#include <stdio.h>
+#include <time.h>
+enum { S_PLAN, S_EXPAND, S_MARK, S_SETTLE, S_INSERT, S_WAIT, S_N };
+static const char *SNAME[S_N] = {"plan", "expand", "mark", "settle", "insert", "barrier"};
+static int64_t swall[8][S_N], scpu[8][S_N];
+static int64_t snow(clockid_t k) { struct timespec ts; clock_gettime(k, &ts); return ts.tv_sec * 1000000000LL + ts.tv_nsec; }
+#define PT(T, PH, STMT) do { int64_t w0_ = snow(CLOCK_MONOTONIC), c0_ = snow(CLOCK_THREAD_CPUTIME_ID); STMT; \
+    if ((T) < 8) { swall[T][PH] += snow(CLOCK_MONOTONIC) - w0_; scpu[T][PH] += snow(CLOCK_THREAD_CPUTIME_ID) - c0_; } } while (0)
+__attribute__((destructor)) static void sprint(void) {
+    for (int t = 0; t < 8; t++) {
+        int64_t any = 0;
+        for (int h = 0; h < S_N; h++) any += swall[t][h];
+        if (!any) continue;
+        fprintf(stderr, "PSTAT thread %d:", t);
+        for (int h = 0; h < S_N; h++) fprintf(stderr, " %s %.3f/%.3f", SNAME[h], swall[t][h] / 1e9, scpu[t][h] / 1e9);
+        fprintf(stderr, " (wall/cpu s)\\n");
+    }
+}
+#else
+#define PT(T, PH, STMT) do { STMT; } while (0)
+#endif
 void prun(Ctx *c, Slice *sl, int64_t t) {
     int64_t sense = 0, k;
     for (;;) {
-        if (t == 0) pplan(c, sl);
-        pbarrier(c, &sense);
+        if (t == 0) PT(t, S_PLAN, pplan(c, sl));
+        PT(t, S_WAIT, pbarrier(c, &sense));
         if (c->status != P_RUN) return;
-        while ((k = ptake(c, &c->cexp)) >= 0) pexpand(c, &sl[k]);
-        pbarrier(c, &sense);
-        while ((k = ptake(c, &c->cmark)) >= 0) {
+        PT(t, S_EXPAND, while ((k = ptake(c, &c->cexp)) >= 0) pexpand(c, &sl[k]));
+        PT(t, S_WAIT, pbarrier(c, &sense));
+        PT(t, S_MARK, while ((k = ptake(c, &c->cmark)) >= 0) {
             Slice *q = &sl[k];
             q->kept = q->a < q->b;
             for (int64_t u = 0; u < k; u++) if (sl[u].r.done < sl[u].b) q->kept = 0;
             q->fresh = q->kept ? pmark(c, sl, k) : 0;
-        }
-        pbarrier(c, &sense);
-        if (t == 0) psettle(c, sl);
-        pbarrier(c, &sense);
-        while ((k = ptake(c, &c->cins)) >= 0) {
+        });
+        PT(t, S_WAIT, pbarrier(c, &sense));
+        if (t == 0) PT(t, S_SETTLE, psettle(c, sl));
+        PT(t, S_WAIT, pbarrier(c, &sense));
+        PT(t, S_INSERT, while ((k = ptake(c, &c->cins)) >= 0) {
             Slice *q = &sl[k];
             if (q->kept) pinsert(c, sl, k);
             for (int64_t d = 0; d < q->r.distinct; d++) q->ltable[q->clocal[d]] = -1;   /* empty again */
             q->r.distinct = 0;
             if (!q->kept) q->r.edges = 0;
-        }
+        });
     }
 }"""
 
@@ -633,6 +692,15 @@ void expand(const U *front, int64_t n, U *out, int32_t *inv, int32_t *rules, int
     for (int q = 1; q < W; q++) hh = (hh ^ (hh >> 31) ^ t[q]) * 0xBF58476D1CE4E5B9ULL; \\
     hh = (hh ^ (hh >> 29)) * 0x94D049BB133111EBULL; \\
     U slot = hh >> (64 - tbits)
+/* before the k successors in succ are probed: their hashes (hs_), each one's first slot and the
+   row its id names asked of memory at once (a probe of a table many times the cache misses
+   twice: the successors' misses overlap instead of queueing) */
+#define SUCC_SLOTS() \\
+    U hs_[NRULES]; \\
+    for (int64_t j_ = 0; j_ < k; j_++) {{ \\
+        const U *t = succ + (size_t)j_ * W; HASH_SLOT(); hs_[j_] = hh; __builtin_prefetch(&table[slot]); }} \\
+    for (int64_t j_ = 0; j_ < k; j_++) {{ \\
+        int32_t g_ = table[hs_[j_] >> (64 - tbits)]; if (g_ >= 0) __builtin_prefetch(keys + (size_t)g_ * KW); }}
 /* bfs: expand the stored states i .. stop-1 (ids in breadth-first order) into the store itself
    (storage.StateStore): its hash table (mix64, triangular probing: the same slots as numpy's),
    byte rows, parents, edges and degrees. Stops before a state whose successors might not fit
@@ -655,9 +723,10 @@ void bfs(int64_t i, int64_t stop, uint8_t *keys, int64_t nk, int64_t klimit, int
         memcpy(s, keys + (size_t)i * KW, KW);      /* little-endian rows (Builder) */
         int64_t k = visit(s, succ, sr, r);
         if (k < 0) break;
+        SUCC_SLOTS();
         for (int64_t j = 0; j < k; j++) {{
             const U *t = succ + (size_t)j * W;
-            HASH_SLOT();
+            U hh = hs_[j], slot = hh >> (64 - tbits);
             memcpy(tb, t, KW);
             int32_t got;
             for (U step = 1;; step++) {{
@@ -677,16 +746,36 @@ void bfs(int64_t i, int64_t stop, uint8_t *keys, int64_t nk, int64_t klimit, int
     }}
     r->done = i; r->edges = ne; r->distinct = nk; r->layers = nl;
 }}
+/* the first slot of stored row i (HASH_SLOT) */
+static inline U rowslot(const uint8_t *keys, int64_t i, int64_t tbits) {{
+    U t[W];
+    memset(t, 0, sizeof t);
+    memcpy(t, keys + (size_t)i * KW, KW);
+    HASH_SLOT();
+    return slot;
+}}
+/* the slots of rows lo .. hi-1, each asked of memory PF rows before it is probed (a rehash is
+   random writes into a table many times the cache: the misses overlap instead of queueing);
+   `place(slot, id)` puts one row */
+#define PF 16
+#define REHASH_LOOP(PLACE) do {{ \
+    U ring_[PF]; \
+    for (int64_t j_ = lo; j_ < hi && j_ < lo + PF; j_++) {{ \
+        ring_[(j_ - lo) % PF] = rowslot(keys, j_, tbits); __builtin_prefetch(&table[ring_[(j_ - lo) % PF]], 1); }} \
+    for (int64_t i_ = lo; i_ < hi; i_++) {{ \
+        U at_ = ring_[(i_ - lo) % PF]; \
+        if (i_ + PF < hi) {{ \
+            U nx_ = rowslot(keys, i_ + PF, tbits); ring_[(i_ - lo) % PF] = nx_; __builtin_prefetch(&table[nx_], 1); }} \
+        PLACE(at_, (int32_t)i_); \
+    }} }} while (0)
+#define RPLACE(SLOT, ID) do {{ U sl_ = (SLOT); \
+    for (U step = 1; table[sl_] >= 0; step++) sl_ = (sl_ + step) & tmask; \
+    table[sl_] = (ID); }} while (0)
 /* the hash table of the stored rows 0 .. n-1 (distinct), as bfs probes it */
 void rehash(const uint8_t *keys, int64_t n, int64_t width, int32_t *table, int64_t tbits) {{
-    U tmask = ((U)1 << tbits) - 1, t[W];
-    for (int64_t i = 0; i < n; i++) {{
-        memset(t, 0, sizeof t);
-        memcpy(t, keys + (size_t)i * KW, KW);
-        HASH_SLOT();
-        for (U step = 1; table[slot] >= 0; step++) slot = (slot + step) & tmask;
-        table[slot] = (int32_t)i;
-    }}
+    U tmask = ((U)1 << tbits) - 1;
+    int64_t lo = 0, hi = n;
+    REHASH_LOOP(RPLACE);
 }}""")
         out.append(_PARALLEL.replace("RULE_T", rule_t).replace("HIT_FULL", str(HIT_FULL)))
         return out
@@ -877,7 +966,7 @@ class Builder:
             if os.environ.get("ARACHNAE_NATIVE", "1") != "0" and sys.byteorder == "little":
                 try:
                     self.src = c_source(self.model, self.shift, self.width, self.total_bits)
-                    digest = hashlib.sha256((self.src + " ".join(CC_FLAGS)).encode()).hexdigest()[:24]
+                    digest = hashlib.sha256((self.src + " ".join(cc_flags())).encode()).hexdigest()[:24]
                     self._lib = _cache_dir() / f"succ_{digest}.so"
                 except Unsupported:
                     pass
@@ -905,7 +994,7 @@ class Builder:
                 with tempfile.TemporaryDirectory(dir=lib.parent) as tmp:
                     c_file, so = Path(tmp) / "succ.c", Path(tmp) / "succ.so"
                     c_file.write_text(self.src)
-                    subprocess.run([cc, *CC_FLAGS, "-o", str(so), str(c_file)], check=True,
+                    subprocess.run([cc, *cc_flags(), "-o", str(so), str(c_file)], check=True,
                                    capture_output=True, timeout=300)
                     os.replace(so, lib)             # atomic: a concurrent run sees all of it or nothing
             except (OSError, subprocess.SubprocessError):

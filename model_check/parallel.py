@@ -69,7 +69,7 @@ class _Ctx(ctypes.Structure):
                 + [(f, ctypes.c_int64) for f in ("width", "tbits", "tlimit", "kcap", "ecap", "dcap", "nk", "ne", "i",
                                                   "workers", "edges_max", "narrow", "fan", "seen_states",
                                                   "seen_edges", "rounds", "status", "cap", "bcount", "bsense", "nrounds",
-                                                  "nsplit", "ndropped", "nslices", "cexp", "cmark", "cins")]
+                                                  "nsplit", "ndropped", "nslices", "cexp", "cmark", "cins", "bsleep")]
                 + [("hit", _Res)])
 
 
@@ -114,7 +114,7 @@ def search(model: Model, store: StateStore, lo: int, nat: Native, workers: int,
         store.rehash = lambda keys, table, bits: _rehash(nat, pool, workers, keys, table, bits)
         while True:
             _bind(ctx, store)
-            ctx.status, ctx.rounds, ctx.bcount, ctx.bsense = P_RUN, ROUNDS, 0, 0
+            ctx.status, ctx.rounds, ctx.bcount, ctx.bsense, ctx.bsleep = P_RUN, ROUNDS, 0, 0, 0
             ctx.cexp = ctx.cmark = ctx.cins = 0
             futures = [pool.submit(prun, ctypes.byref(ctx), csl, ctypes.c_int64(t)) for t in range(1, workers)]
             prun(ctypes.byref(ctx), csl, ctypes.c_int64(0))
