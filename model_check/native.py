@@ -273,14 +273,14 @@ _PARALLEL = """\
 typedef struct {
     int32_t *ev; RULE_T *er; uint8_t *crow; int32_t *cpar; U *chash; int64_t *cslot, *cstep;
     int32_t *clocal, *ltable, *cown, *cidx;
-    int64_t lbits, a, b, edge0, fresh, base, kept;
+    int64_t lbits, a, b, edge0, fresh, base, kept, ready;
     Res r;
 } Slice;
 typedef struct {
     uint8_t *keys; int32_t *parent, *table, *dst; RULE_T *rules; uint16_t *degree;
     int64_t width, tbits, tlimit, kcap, ecap, dcap, nk, ne, i, workers, edges_max, narrow, fan,
             seen_states, seen_edges, rounds, status, cap, bcount, bsense, nrounds, nsplit, ndropped,
-            nslices, cexp, cmark, cins, bsleep;
+            nslices, cexp, cmark, bsleep;
     Res hit;
 } Ctx;
 enum { P_RUN, P_DONE, P_PAUSE, P_GROW, P_HIT };
@@ -328,6 +328,7 @@ static void pexpand(const Ctx *c, Slice *q) {
     const int32_t *table = c->table;
     int64_t ne = 0, nc = 0, i = q->a;
     Res *r = &q->r;
+    for (int64_t d = 0; d < r->distinct; d++) q->ltable[q->clocal[d]] = -1;   /* last round's: empty again */
     r->kind = 0;
     for (; i < q->b; i++) {
         if (ne + NRULES > c->cap) { r->kind = HIT_FULL; break; }
@@ -436,7 +437,8 @@ static void pinsert(const Ctx *c, Slice *sl, int64_t t) {
 /* thread 0, before a round: the slices, or why not (the search is over, arrays to grow, a pause) */
 static void pplan(Ctx *c, Slice *sl) {
     int64_t n = c->nslices;
-    c->cmark = 0;
+    c->cexp = c->cmark = 0;
+    for (int64_t u = 0; u < n; u++) sl[u].ready = 0;
     if (c->status != P_RUN) return;
     if (c->i == c->nk) { c->status = P_DONE; return; }
     if (c->rounds-- <= 0) { c->status = P_PAUSE; return; }
@@ -455,13 +457,12 @@ static void pplan(Ctx *c, Slice *sl) {
     }
     c->cap = cap;
 }
-/* thread 0, after the marks: bases and edge places of the kept slices, the counts, a hit */
+/* thread 0, after a round: the counts, a hit */
 static void psettle(Ctx *c, Slice *sl) {
     int64_t nk = c->nk, ne = c->ne, last = 0, busy = 0;
-    c->cexp = c->cins = 0;
     for (int64_t u = 0; u < c->nslices && sl[u].kept; u++) {
-        sl[u].base = nk; nk += sl[u].fresh;
-        sl[u].edge0 = ne; ne += sl[u].r.edges;
+        nk += sl[u].fresh;
+        ne += sl[u].r.edges;
         last = u;
     }
     for (int64_t u = 0; u < c->nslices; u++) busy += sl[u].a < sl[u].b;
@@ -472,14 +473,15 @@ static void psettle(Ctx *c, Slice *sl) {
     c->seen_states += r->done - sl[0].a;
     c->seen_edges += ne - c->ne;
     c->nk = nk; c->ne = ne; c->i = r->done;
-    /* successors per state to plan for: twice the highest mean of this round's slices; after a
-       round that dropped slices, twice what was planned */
+    /* successors per state to plan for: twice the highest mean of this round's slices, at least
+       7/8 of the last round's plan; after a round that dropped slices, twice what was planned */
     int64_t fan = 1;
     for (int64_t u = 0; u <= last; u++) {
         int64_t m = sl[u].r.done > sl[u].a ? (2 * sl[u].r.edges + sl[u].r.done - sl[u].a - 1) / (sl[u].r.done - sl[u].a) : 1;
         if (m > fan) fan = m;
     }
     if (busy > last + 1) fan = 2 * c->fan;
+    else if (fan < c->fan - c->fan / 8) fan = c->fan - c->fan / 8;    /* down slowly: fewer drops (158 -> 53 of 988 rounds) */
     c->fan = fan > NRULES ? NRULES : fan;
     if (r->kind != 0 && r->kind != HIT_FULL) { c->hit = *r; c->status = P_HIT; }
 }
@@ -492,8 +494,8 @@ static inline int64_t ptake(const Ctx *c, int64_t *next) {
 #ifdef PSTAT    /* phase timers (ARACHNAE_NATIVE_CFLAGS=-DPSTAT): wall and CPU ns per thread, printed at exit */
 #include <stdio.h>
 #include <time.h>
-enum { S_PLAN, S_EXPAND, S_MARK, S_SETTLE, S_INSERT, S_WAIT, S_N };
-static const char *SNAME[S_N] = {"plan", "expand", "mark", "settle", "insert", "barrier"};
+enum { S_PLAN, S_EXPAND, S_INSERT, S_WAIT, S_N };
+static const char *SNAME[S_N] = {"settle+plan", "expand", "mark+insert", "barrier"};
 static int64_t swall[8][S_N], scpu[8][S_N];
 static int64_t snow(clockid_t k) { struct timespec ts; clock_gettime(k, &ts); return ts.tv_sec * 1000000000LL + ts.tv_nsec; }
 #define PT(T, PH, STMT) do { int64_t w0_ = snow(CLOCK_MONOTONIC), c0_ = snow(CLOCK_THREAD_CPUTIME_ID); STMT; \
@@ -511,6 +513,29 @@ __attribute__((destructor)) static void sprint(void) {
 #else
 #define PT(T, PH, STMT) do { STMT; } while (0)
 #endif
+/* slice k after the expansion: whether it is kept, its candidates marked, its base id and edge
+   place (after slice k-1's: waits until that slice has them, taken before k and in hand), then
+   its rows, table slots and edges; marking reads the tables of the slices before, so a slice's
+   table is emptied at its next expansion */
+static void pput(Ctx *c, Slice *sl, int64_t k) {
+    Slice *q = &sl[k];
+    q->kept = q->a < q->b;
+    for (int64_t u = 0; u < k; u++) if (sl[u].r.done < sl[u].b) q->kept = 0;
+    q->fresh = q->kept ? pmark(c, sl, k) : 0;
+    if (k == 0) { q->base = c->nk; q->edge0 = c->ne; }
+    else {
+        const Slice *p = &sl[k - 1];
+        for (int w = 0; !__atomic_load_n(&p->ready, __ATOMIC_ACQUIRE); w++)
+            if (w < SPIN) prelax(); else sched_yield();
+        q->base = p->base + p->fresh;
+        q->edge0 = p->edge0 + (p->kept ? p->r.edges : 0);
+    }
+    __atomic_store_n(&q->ready, 1, __ATOMIC_RELEASE);
+    if (q->kept) pinsert(c, sl, k);
+    else q->r.edges = 0;
+}
+/* rounds: thread 0 plans (after settling the last round), then every thread expands slices,
+   then marks and puts them: two barriers a round after the plan's */
 void prun(Ctx *c, Slice *sl, int64_t t) {
     int64_t sense = 0, k;
     for (;;) {
@@ -519,22 +544,9 @@ void prun(Ctx *c, Slice *sl, int64_t t) {
         if (c->status != P_RUN) return;
         PT(t, S_EXPAND, while ((k = ptake(c, &c->cexp)) >= 0) pexpand(c, &sl[k]));
         PT(t, S_WAIT, pbarrier(c, &sense));
-        PT(t, S_MARK, while ((k = ptake(c, &c->cmark)) >= 0) {
-            Slice *q = &sl[k];
-            q->kept = q->a < q->b;
-            for (int64_t u = 0; u < k; u++) if (sl[u].r.done < sl[u].b) q->kept = 0;
-            q->fresh = q->kept ? pmark(c, sl, k) : 0;
-        });
+        PT(t, S_INSERT, while ((k = ptake(c, &c->cmark)) >= 0) pput(c, sl, k));
         PT(t, S_WAIT, pbarrier(c, &sense));
-        if (t == 0) PT(t, S_SETTLE, psettle(c, sl));
-        PT(t, S_WAIT, pbarrier(c, &sense));
-        PT(t, S_INSERT, while ((k = ptake(c, &c->cins)) >= 0) {
-            Slice *q = &sl[k];
-            if (q->kept) pinsert(c, sl, k);
-            for (int64_t d = 0; d < q->r.distinct; d++) q->ltable[q->clocal[d]] = -1;   /* empty again */
-            q->r.distinct = 0;
-            if (!q->kept) q->r.edges = 0;
-        });
+        if (t == 0) PT(t, S_PLAN, psettle(c, sl));
     }
 }"""
 

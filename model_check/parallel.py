@@ -60,7 +60,7 @@ class Rounds:
 class _CSlice(ctypes.Structure):
     _fields_ = ([(f, ctypes.c_void_p) for f in ("ev", "er", "crow", "cpar", "chash", "cslot", "cstep", "clocal",
                                                   "ltable", "cown", "cidx")]
-                + [(f, ctypes.c_int64) for f in ("lbits", "a", "b", "edge0", "fresh", "base", "kept")]
+                + [(f, ctypes.c_int64) for f in ("lbits", "a", "b", "edge0", "fresh", "base", "kept", "ready")]
                 + [("r", _Res)])
 
 
@@ -69,7 +69,7 @@ class _Ctx(ctypes.Structure):
                 + [(f, ctypes.c_int64) for f in ("width", "tbits", "tlimit", "kcap", "ecap", "dcap", "nk", "ne", "i",
                                                   "workers", "edges_max", "narrow", "fan", "seen_states",
                                                   "seen_edges", "rounds", "status", "cap", "bcount", "bsense", "nrounds",
-                                                  "nsplit", "ndropped", "nslices", "cexp", "cmark", "cins", "bsleep")]
+                                                  "nsplit", "ndropped", "nslices", "cexp", "cmark", "bsleep")]
                 + [("hit", _Res)])
 
 
@@ -115,7 +115,6 @@ def search(model: Model, store: StateStore, lo: int, nat: Native, workers: int,
         while True:
             _bind(ctx, store)
             ctx.status, ctx.rounds, ctx.bcount, ctx.bsense, ctx.bsleep = P_RUN, ROUNDS, 0, 0, 0
-            ctx.cexp = ctx.cmark = ctx.cins = 0
             futures = [pool.submit(prun, ctypes.byref(ctx), csl, ctypes.c_int64(t)) for t in range(1, workers)]
             prun(ctypes.byref(ctx), csl, ctypes.c_int64(0))
             for f in futures:
