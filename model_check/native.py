@@ -381,6 +381,8 @@ static int64_t pmark(const Ctx *c, Slice *sl, int64_t t) {
     for (int64_t d = 0; d < q->r.distinct; d++) {
         const uint8_t *tb = q->crow + (size_t)d * KW;
         int32_t own = (int32_t)t, at = -1;
+        if (d + PF < q->r.distinct)         /* the slots PF candidates on, asked of memory now */
+            for (int64_t u = 0; u < t; u++) __builtin_prefetch(&sl[u].ltable[q->chash[d + PF] & lmask]);
         for (int64_t u = 0; u < t && at < 0; u++) {
             U ls = q->chash[d] & lmask;
             for (U lstep = 1;; lstep++) {
@@ -416,6 +418,7 @@ static void pinsert(const Ctx *c, Slice *sl, int64_t t) {
     Slice *q = &sl[t];
     U tmask = ((U)1 << c->tbits) - 1;
     for (int64_t d = 0; d < q->r.distinct; d++) {
+        if (d + PF < q->r.distinct) __builtin_prefetch(&c->table[q->cslot[d + PF]], 1);  /* as pmark */
         if (q->cown[d] != t) continue;
         int32_t id = (int32_t)(q->base + q->cidx[d]);
         memcpy(c->keys + (size_t)id * KW, q->crow + (size_t)d * KW, KW);
