@@ -52,7 +52,8 @@ def main() -> None:
           f"{c2:.2f} CPU s: speed-up {w1 / w2:.2f}x (wall), CPU {c2 / c1:.2f}x the one-thread search's; "
           f"{'counts agree' if len(counts) == 1 else 'COUNTS DIFFER'}")
     print(f"(on {os.cpu_count()} cores; the ideal is {min(args.workers, os.cpu_count() or 1)}x; the new states are "
-          "put into the shared table after each round's expansion, and the rounds wait for their slowest thread)")
+          "put into the shared table after each round's expansion, and the rounds wait for their slowest thread; "
+          "growing the arrays and the table runs between rounds on one thread)")
 
 
 if __name__ == "__main__":

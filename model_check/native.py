@@ -251,18 +251,23 @@ out:
 
 # The parallel search (model_check.parallel): `prun`, called on every thread at once (thread t),
 # runs rounds over `bfs`'s hash table and rows until the search ends, a hit, `rounds` rounds, or
-# arrays to grow; threads meet at barriers in C (no Python between the steps). A round: thread 0
-# cuts the next states into consecutive slices (several per thread); then, the threads taking
-# the slices as they come free (ptake), each slice
+# arrays to grow; threads meet at barriers in C (no Python between the steps; a short spin, then
+# a futex sleep). A round: thread 0 settles the last round and cuts the next states into
+# consecutive slices (several per thread); then, the threads taking the slices as they come free
+# (ptake), each slice
 # - is expanded against the table as it is, read only; a successor not in it becomes a
 #   candidate, deduplicated in the slice's own table, with its hash and where its probe of the
 #   shared table stopped (slot, step);
+# then (a barrier) each slice, in the same step (pput):
 # - (kept if every slice before it finished) has its candidates marked: one an earlier slice has too is
 #   that slice's (the earliest), the others are new, numbered in first-seen order;
-# - (thread 0: each slice's base id is the stored states plus the new ones of the slices before)
-#   writes each new candidate's row and parent at base + number and claims a table slot for its
-#   id with a compare-and-swap from where its probe stopped (the slots before it stay taken), and
-#   its edges, each candidate turned into its id, at their place in the store.
+# - takes its base id and edge place after the slice before it (the stored states plus the new
+#   ones of the slices before), then writes each new candidate's row and parent at base + number
+#   and claims a table slot for its id with a compare-and-swap from where its probe stopped (the
+#   slots before it stay taken), and its edges, each candidate turned into its id, at their
+#   place in the store.
+# Three barriers a round (plan, expand, put). Table slots are prefetched a few candidates ahead
+# (the claim and the mark stall on misses otherwise).
 _PARALLEL = """\
 #include <sched.h>
 #ifdef __linux__
@@ -500,6 +505,8 @@ static inline int64_t ptake(const Ctx *c, int64_t *next) {
 enum { S_PLAN, S_EXPAND, S_INSERT, S_WAIT, S_N };
 static const char *SNAME[S_N] = {"settle+plan", "expand", "mark+insert", "barrier"};
 static int64_t swall[8][S_N], scpu[8][S_N];
+static int64_t sedges, scand, sfresh, skept;     /* edges and candidates expanded, new states, edges kept */
+#define PCOUNT(X, N) __atomic_add_fetch(&(X), (N), __ATOMIC_RELAXED)
 static int64_t snow(clockid_t k) { struct timespec ts; clock_gettime(k, &ts); return ts.tv_sec * 1000000000LL + ts.tv_nsec; }
 #define PT(T, PH, STMT) do { int64_t w0_ = snow(CLOCK_MONOTONIC), c0_ = snow(CLOCK_THREAD_CPUTIME_ID); STMT; \
     if ((T) < 8) { swall[T][PH] += snow(CLOCK_MONOTONIC) - w0_; scpu[T][PH] += snow(CLOCK_THREAD_CPUTIME_ID) - c0_; } } while (0)
@@ -512,9 +519,12 @@ __attribute__((destructor)) static void sprint(void) {
         for (int h = 0; h < S_N; h++) fprintf(stderr, " %s %.3f/%.3f", SNAME[h], swall[t][h] / 1e9, scpu[t][h] / 1e9);
         fprintf(stderr, " (wall/cpu s)\\n");
     }
+    if (sedges) fprintf(stderr, "PSTAT edges expanded %lld (kept %lld), candidates %lld, new states %lld\\n",
+                        (long long)sedges, (long long)skept, (long long)scand, (long long)sfresh);
 }
 #else
 #define PT(T, PH, STMT) do { STMT; } while (0)
+#define PCOUNT(X, N) ((void)0)
 #endif
 /* slice k after the expansion: whether it is kept, its candidates marked, its base id and edge
    place (after slice k-1's: waits until that slice has them, taken before k and in hand), then
@@ -534,6 +544,7 @@ static void pput(Ctx *c, Slice *sl, int64_t k) {
         q->edge0 = p->edge0 + (p->kept ? p->r.edges : 0);
     }
     __atomic_store_n(&q->ready, 1, __ATOMIC_RELEASE);
+    PCOUNT(sedges, q->r.edges); PCOUNT(scand, q->r.distinct); PCOUNT(sfresh, q->fresh); PCOUNT(skept, q->kept ? q->r.edges : 0);
     if (q->kept) pinsert(c, sl, k);
     else q->r.edges = 0;
 }

@@ -7,18 +7,21 @@ writes the same store as the one-thread `bfs` (model_check.native), so responses
 final checks and counterexamples run on it unchanged. The search goes in rounds, all
 in C (native.py `prun`, called on every thread; the threads meet at barriers in C):
 
-1. thread 0 cuts the next stored states (they may run on into the next layer) into
-   consecutive slices, SLICES per thread; in each step below the threads take the slices as
-   they come free, so a thread held up by other load holds the round up less;
+1. thread 0 settles the last round and cuts the next stored states (they may run on into the
+   next layer) into consecutive slices, SLICES per thread; in each step below the threads take
+   the slices as they come free, so a thread held up by other load holds the round up less;
 2. each slice is expanded against the table as it is (read only): an edge to a
    stored state gets its id; a successor not stored becomes a candidate of the slice,
    deduplicated in the slice's own table;
-3. a candidate an earlier slice has too is that slice's; the others are new, numbered in
-   first-seen order;
-4. each slice's new states get ids after the stored states and the new ones of the slices
-   before it, so ids, parents (the source of a state's first edge) and edges are those of
-   the one-thread search; rows, parents, table slots (compare-and-swap) and edges are
-   written by all threads at once.
+3. each slice in turn (one step: a slice waits for the one before it to have its base): a
+   candidate an earlier slice has too is that slice's; the others are new, numbered in
+   first-seen order, and get ids after the stored states and the new ones of the slices
+   before, so ids, parents (the source of a state's first edge) and edges are those of the
+   one-thread search; rows, parents, table slots (compare-and-swap) and edges are written by
+   all threads at once.
+
+The threads meet at three barriers a round (a short spin, then a futex sleep: a thread waiting
+for one that other load holds up gives its core away).
 
 A slice that fills its buffers (or holds a hit) ends the round there: the slices after it
 are expanded again in the next round. Only the hash table's slot order may differ from the
