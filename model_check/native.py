@@ -413,6 +413,10 @@ static inline void pclaim(int32_t *table, U slot, U step, U tmask, int32_t id) {
         slot = (slot + step) & tmask;
     }
 }
+/* slots lo .. hi-1 of a new table emptied (-1) on one of several threads, before any prehash */
+void pfill(int32_t *table, int64_t lo, int64_t hi) {
+    memset(table + lo, 0xff, (size_t)(hi - lo) * sizeof *table);
+}
 /* rehash's part lo .. hi-1 on one of several threads at once (the slot order may differ) */
 #define PPLACE(SLOT, ID) pclaim(table, (SLOT), 1, tmask, (ID))
 void prehash(const uint8_t *keys, int64_t lo, int64_t hi, int32_t *table, int64_t tbits) {
@@ -797,10 +801,11 @@ static inline U rowslot(const uint8_t *keys, int64_t i, int64_t tbits) {{
 #define RPLACE(SLOT, ID) do {{ U sl_ = (SLOT); \
     for (U step = 1; table[sl_] >= 0; step++) sl_ = (sl_ + step) & tmask; \
     table[sl_] = (ID); }} while (0)
-/* the hash table of the stored rows 0 .. n-1 (distinct), as bfs probes it */
+/* the hash table (its slots not yet set) of the stored rows 0 .. n-1 (distinct), as bfs probes it */
 void rehash(const uint8_t *keys, int64_t n, int64_t width, int32_t *table, int64_t tbits) {{
     U tmask = ((U)1 << tbits) - 1;
     int64_t lo = 0, hi = n;
+    memset(table, 0xff, ((size_t)1 << tbits) * sizeof *table);      /* every slot -1: empty */
     REHASH_LOOP(RPLACE);
 }}""")
         out.append(_PARALLEL.replace("RULE_T", rule_t).replace("HIT_FULL", str(HIT_FULL)))
@@ -931,7 +936,7 @@ class Native:
         return Stop(int(r.done), int(r.kind), int(r.index), message, self.layers[:r.layers].tolist())
 
     def rehash(self, keys: np.ndarray, table: np.ndarray, bits: int) -> None:
-        """Fill the empty `table` (int32, 2^bits slots) with the ids of the stored byte rows."""
+        """Fill `table` (int32, 2^bits slots, not yet set: np.empty) with the ids of the stored byte rows."""
         p, n64 = ctypes.c_void_p, ctypes.c_int64
         self.lib.rehash.restype = None
         self.lib.rehash(p(keys.ctypes.data), n64(len(keys)), n64(keys.shape[1]), p(table.ctypes.data), n64(bits))

@@ -118,10 +118,7 @@ def search(model: Model, store: StateStore, lo: int, nat: Native, workers: int,
         while True:
             _bind(ctx, store)
             ctx.status, ctx.rounds, ctx.bcount, ctx.bsense, ctx.bsleep = P_RUN, ROUNDS, 0, 0, 0
-            futures = [pool.submit(prun, ctypes.byref(ctx), csl, ctypes.c_int64(t)) for t in range(1, workers)]
-            prun(ctypes.byref(ctx), csl, ctypes.c_int64(0))
-            for f in futures:
-                f.result()
+            _on_threads(pool, prun, [(ctypes.byref(ctx), csl, ctypes.c_int64(t)) for t in range(workers)])
             rounds.rounds, rounds.split, rounds.dropped = ctx.nrounds, ctx.nsplit, ctx.ndropped
             store.keys.n = store.parent.n = ctx.nk
             store.dst.n = store.rule.n = ctx.ne
@@ -143,14 +140,21 @@ def search(model: Model, store: StateStore, lo: int, nat: Native, workers: int,
 
 def _rehash(nat: Native, pool: ThreadPoolExecutor, workers: int, keys: np.ndarray, table: np.ndarray,
             bits: int) -> None:
-    """`Native.rehash` on all the threads (a part of the rows each; the serial rehash was
-    6.6% of a two-thread profile): the empty `table` gets the ids of the stored rows."""
-    fn = nat.lib.prehash
-    fn.restype = None
+    """`Native.rehash` on all the threads (the serial rehash was 6.6% of a two-thread profile):
+    each empties a part of the slots of `table` (not yet set: np.empty, so its pages are first
+    touched here, on the threads), then, once all are empty, puts a part of the stored rows."""
     p, n64 = ctypes.c_void_p, ctypes.c_int64
+    slots = [len(table) * t // workers for t in range(workers + 1)]
+    _on_threads(pool, nat.lib.pfill, [(p(table.ctypes.data), n64(slots[t]), n64(slots[t + 1]))
+                                      for t in range(workers)])
     cuts = [len(keys) * t // workers for t in range(workers + 1)]
-    args = [(p(keys.ctypes.data), n64(cuts[t]), n64(cuts[t + 1]), p(table.ctypes.data), n64(bits))
-            for t in range(workers)]
+    _on_threads(pool, nat.lib.prehash, [(p(keys.ctypes.data), n64(cuts[t]), n64(cuts[t + 1]),
+                                         p(table.ctypes.data), n64(bits)) for t in range(workers)])
+
+
+def _on_threads(pool: ThreadPoolExecutor, fn, args: list[tuple]) -> None:
+    """`fn(*args[t])` on thread t of the search (0: this one), until all have returned."""
+    fn.restype = None
     futures = [pool.submit(fn, *a) for a in args[1:]]
     fn(*args[0])
     for f in futures:
