@@ -121,3 +121,26 @@ def test_extra_compiler_flags_build_their_own_library(monkeypatch, rounds):
     par = explore(model, comp, progress=False, use_native=True, workers=2)
     assert par.native is not None and par.rounds.rounds > 0
     assert all(np.array_equal(a, b) for a, b in zip(_store(par), _store(seq)))
+
+
+def test_a_grown_table_is_emptied_by_its_rehash(monkeypatch, rounds):
+    """The compiled search's grown table comes unset (np.empty): its rehash empties every slot
+    itself (on all the threads in the threaded search). Filled with a stored id first (what a
+    slot it missed would hold), the table still gives the one store."""
+    model = toys.torus(3, 20)                                  # 8,000 states: the table grows twice
+    ref = explore(model, progress=False, use_native=True)
+    calls = []
+
+    def dirty(fn):
+        def rehash(*a):
+            table = a[-2]
+            table[:] = 0
+            calls.append(len(table))
+            fn(*a)
+        return rehash
+    monkeypatch.setattr(native.Native, "rehash", dirty(native.Native.rehash))
+    monkeypatch.setattr(parallel, "_rehash", dirty(parallel._rehash))
+    for workers in (1, 2):
+        got = explore(model, progress=False, use_native=True, workers=workers)
+        assert got.states == ref.states and all(np.array_equal(a, b) for a, b in zip(_store(got), _store(ref)))
+    assert len(calls) >= 2 and max(calls) >= 1 << 14, calls
