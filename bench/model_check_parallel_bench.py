@@ -53,7 +53,7 @@ def main() -> None:
           f"{'counts agree' if len(counts) == 1 else 'COUNTS DIFFER'}")
     print(f"(on {os.cpu_count()} cores; the ideal is {min(args.workers, os.cpu_count() or 1)}x; the new states are "
           "put into the shared table after each round's expansion, and the rounds wait for their slowest thread; "
-          "growing the arrays and the table runs between rounds on one thread)")
+          "between rounds the threads rehash a grown table while the others wait)")
 
 
 if __name__ == "__main__":
