@@ -101,7 +101,6 @@ class Gait:
         self.phase = 0.0                             # total gait phase (cycles)
         self.scale = 1.0                             # gait clock speed (slowed on servo over-temperature)
         self.pending = True                          # re-phase when every foot is down
-        self.mixed = False                           # legs out of the pattern's order since a turn (`_flip`)
         self.paused = False
         self.gait_switches = 0
         self.pause_s = 0.0
@@ -172,16 +171,13 @@ class Gait:
         if self._reversal(cmd):
             self._reverse(cmd)
             return
-        flips = self._flipping_legs(cmd)
         was, self.command = self.command, cmd
         # react now (seed 5.2): stance feet carry on in the new direction from where they are,
         # swinging feet re-aim their touchdown; the phase is re-fitted once every foot is down,
         # unless the pattern can walk on in its rhythm
         for leg in self.legs:
             pl = self.plans[leg]
-            if leg in flips:
-                self._flip(leg)
-            elif pl.swing:
+            if pl.swing:
                 left = pl.t0 + pl.dur - self.t
                 if left >= T.GAIT_MIN_SWING * self.t_swing:   # else it lands where it aimed
                     x, y, z = self.target(leg)                  # re-aimed from where it is (as the LCP does)
@@ -190,68 +186,7 @@ class Gait:
                     pl.cmd = cmd
             else:
                 pl.c = self._project(leg, pl.pos) if cmd != STOP else 0.0
-                if flips and self.phase + (pl.c + 0.5) * self.duty < pl.next_lift:
-                    self._lift_at(leg, self.phase + (pl.c + 0.5) * self.duty)   # its new stroke ends sooner
-        self.pending = self.pending or not (flips or self._keeps_rhythm(cmd, was))
-
-    def _flipping_legs(self, cmd: int) -> set[int]:
-        """Legs whose stance runs backwards after a change into or out of a turn (seed 5.2: react now).
-
-        Turning, the feet on one side push the way walking forward does and those on the other side the
-        way walking backward does: a change between a turn and a straight line (or the other turn's
-        sidestep) reverses some legs' strokes and keeps or crosses the others'. Each reversed leg is
-        mirrored in its own cycle (`_flip`), the others keep the rhythm (lifting sooner where their new
-        stroke ends sooner), so no foot waits for all to land (issue 17: between a straight line and a turn
-        the cost no longer depends on where in the cycle the key came; between a turn and a sidestep, where
-        the middle legs cross, it still does, less). Empty (re-phase
-        once every foot is down) for a start, a stop, a pending re-phase, two straight lines (their own
-        rule), where waiting is short (the wave) and where a side lifts two feet at once (the tripod:
-        mirrored, its groups split and the body would wait for support, measured 0.017-0.285 m forward
-        in the 3 s after a turn-to-forward key, against 0.261-0.265 m re-phasing).
-        """
-        if self.pending or STOP in (cmd, self.command) or not self._waiting_drifts_far():
-            return set()
-        if not self._one_up_per_side():
-            return set()
-        if _straight(cmd) and _straight(self.command):
-            return set()
-        flips = set()
-        for leg in self.legs:
-            (ax, ay), (bx, by) = self._stroke_dir(leg, self.command), self._stroke_dir(leg, cmd)
-            if ax * bx + ay * by < -T.GAIT_FLIP_COS * math.hypot(ax, ay) * math.hypot(bx, by):
-                flips.add(leg)
-        return flips
-
-    def _one_up_per_side(self) -> bool:
-        """The running pattern never has two feet of one side in the air at once."""
-        duty, offset = pattern(self.running, self.legs)
-        return all(min((offset[a] - offset[b]) % 1.0, (offset[b] - offset[a]) % 1.0) >= 1 - duty - 1e-9
-                   for a in self.legs for b in self.legs if a < b and self.p.side(a) == self.p.side(b))
-
-    def _stroke_dir(self, leg: int, cmd: int) -> tuple[float, float]:
-        """Which way the leg's stance foot moves through its neutral point under `cmd` (body frame)."""
-        (x0, y0), (x1, y1) = self.path(leg, -0.01, cmd), self.path(leg, 0.01, cmd)
-        return x0 - x1, y0 - y1
-
-    def _flip(self, leg: int) -> None:
-        """Mirror one leg in its own cycle after its stroke reversed (the per-leg form of `_reverse`).
-
-        A stance foot lifts when it reaches the rear end of its new stroke; a swinging foot flies back
-        to where it lifted off in what its swing has taken so far. The leg's offset follows, so that
-        a later reversal or re-phase sees where it is.
-        """
-        pl, self.mixed = self.plans[leg], True
-        if pl.swing:     # its new touchdown point is not quite where it lifted off: no faster than a normal swing
-            pl.dur = max(self._fly_back(leg), math.dist(pl.pos, pl.end) * self.t_swing / self.stroke)
-            self._lift_at(leg, self.phase + pl.dur / self.cycle + self.duty)
-        else:
-            pl.c = self._project(leg, pl.pos)
-            self._lift_at(leg, self.phase + (pl.c + 0.5) * self.duty)
-
-    def _lift_at(self, leg: int, phase: float) -> None:
-        """The leg's next lift-off at this total phase; its offset follows (a later reversal sees where it is)."""
-        self.plans[leg].next_lift = phase
-        self.offset[leg] = (phase - self.duty) % 1.0
+        self.pending = self.pending or not self._keeps_rhythm(cmd, was)
 
     def _keeps_rhythm(self, cmd: int, was: int) -> bool:
         """Walk on in the running pattern (no wait for every foot down) after a change from `was` to `cmd`.
@@ -261,8 +196,8 @@ class Gait:
         whole stroke later). Waiting for the swinging feet to land instead lets every stance foot drift
         t_swing / t_stance strokes towards its rear limit at once, and the pause then depends on where in
         the cycle the command came (issue 17): the rhythm is kept where that drift is the larger (tripod,
-        ripple; the wave lifts one foot at a time and waits). A start or a stop re-phases once every foot is
-        down; a turn: `_flipping_legs`.
+        ripple; the wave lifts one foot at a time and waits). A start, a stop or a turn (the feet scatter
+        along their new arcs) re-phases once every foot is down.
         """
         return _straight(cmd) and _straight(was) and self._waiting_drifts_far()
 
@@ -290,23 +225,17 @@ class Gait:
         self.phase = math.floor(self.phase) + 1.0 + (self.duty - self.phase) % 1.0
         for leg in self.legs:
             pl = self.plans[leg]
-            if pl.swing:
-                pl.next_lift = self.phase + self._fly_back(leg) / self.cycle + self.duty
+            if pl.swing:                               # flies back to where it lifted off in what its swing has taken so far
+                x, y, z = self.target(leg)
+                left = max(self.t - pl.t0, self.dt)    # its own clock: the phase may call it landed a tick early
+                if left < T.GAIT_MIN_SWING * self.t_swing:    # barely lifted: straight back down, no higher
+                    pl.lift = z
+                pl.pos, pl.z0, pl.t0, pl.dur = (x, y), z, self.t, left
+                pl.end, pl.cmd = self.path(leg, 0.5), cmd
+                pl.next_lift = self.phase + left / self.cycle + self.duty
             else:
                 pl.c = -pl.c
                 pl.next_lift = self.phase + stance_so_far[leg]     # back to its new rear end in what its stance took
-
-    def _fly_back(self, leg: int) -> float:
-        """A swinging foot whose stroke reversed flies back to where it lifted off in what its swing has taken
-        so far (its own clock: the phase may call it landed a tick early); returns that time (gait s)."""
-        pl = self.plans[leg]
-        x, y, z = self.target(leg)
-        left = max(self.t - pl.t0, self.dt)
-        if left < T.GAIT_MIN_SWING * self.t_swing:    # barely lifted: straight back down, no higher
-            pl.lift = z
-        pl.pos, pl.z0, pl.t0, pl.dur = (x, y), z, self.t, left
-        pl.end, pl.cmd = self.path(leg, 0.5), self.command
-        return left
 
     def drop_leg(self, leg: int) -> None:
         """A leg is lost (seed 6.3: five of six suffice): walk the five-legged wave from the next all-feet-down."""
@@ -348,7 +277,7 @@ class Gait:
             for leg in self.legs:
                 pl = self.plans[leg]
                 due = self.phase >= pl.next_lift - 0.5 * dt / self.cycle      # on the tick nearest its time
-                if not pl.swing and due and up < self.max_up and self._holds_without(leg):   # never more feet up than the pattern lifts
+                if not pl.swing and due and up < self.max_up:   # never more feet up than the pattern lifts
                     up += 1
                     late = max(0.0, (self.phase - pl.next_lift) * self.cycle)
                     self._lift(leg, max(self.t_swing * T.GAIT_MIN_SWING, self.t_swing - late))
@@ -366,27 +295,6 @@ class Gait:
                 pl.pos = self._move(pl.pos, dc)
                 pl.c -= dc
 
-    def _holds_without(self, leg: int) -> bool:
-        """The stance feet but `leg` keep the body centre inside their polygon (seed 6.3: statically stable).
-
-        Checked only while legs are out of the pattern's order after a turn (`_flip`): a re-phased
-        pattern is stable by construction. Checked where the feet are now and where the body motion
-        takes them by the swing's end (the polygon moves rigidly, so in between too). The centre is
-        inside when, taken round it by angle, no two neighbouring feet are half a turn or more apart.
-        """
-        if not self.mixed:
-            return True
-        feet = [pl.pos for lg, pl in self.plans.items() if lg in self.legs and lg != leg and not pl.swing]
-        if len(feet) < 3:
-            return False
-        later = [self._move(p, self.t_swing / self.t_stance) for p in feet]
-        for points in (feet, later):
-            angles = sorted(math.atan2(y, x) for x, y in points)
-            gaps = [b - a for a, b in zip(angles, angles[1:])] + [angles[0] + 2 * math.pi - angles[-1]]
-            if max(gaps) >= math.pi - T.GAIT_SUPPORT_MARGIN_RAD:
-                return False
-        return True
-
     def _lift(self, leg: int, dur: float) -> None:
         pl = self.plans[leg]
         pl.swing, pl.t0, pl.dur, pl.z0 = True, self.t - self.dt, dur, 0.0   # the step began this tick
@@ -396,7 +304,6 @@ class Gait:
     def _rephase(self) -> None:
         """Choose the new pattern's phase that fits where the stance feet are (no foot overruns its stroke)."""
         self.offset = pattern(self.running, self.legs)[1]      # the right way round again after a reversal
-        self.mixed = False
         best, best_phi = math.inf, 0.0
         for i in range(T.GAIT_REPHASE_STEPS):
             phi = i / T.GAIT_REPHASE_STEPS

@@ -24,8 +24,6 @@ GAIT_OVERRUN = 0.15           # a stance foot may go this fraction of a stroke p
 GAIT_MIN_SWING = 0.5          # a swing never lasts less than half its normal time (late lift-off after a re-phase),
                               # and is re-aimed at a new direction's touchdown only with at least that much time left
 GAIT_REPHASE_STEPS = 48       # candidate phases tried when fitting a new gait to where the feet are
-GAIT_FLIP_COS = 0.3            # a leg's stroke counts as reversed by a direction change below -this cosine
-GAIT_SUPPORT_MARGIN_RAD = 0.1  # out of order after a turn, a foot lifts only if the others' angular gap round the centre stays this far below half a turn
 GAIT_OVERRUN_WEIGHT = 100.0   # cost of an overrun (per stroke squared) against a merely short or long step
 GAIT_FIVE_LEG_STROKE = 0.5    # five legs: half the stroke, so four feet always hold the body inside their polygon
 GAIT_FIVE_LEG_SPREAD = 0.5    # five legs: the two feet on the lost leg's side stand at +-this x the front hip's x
