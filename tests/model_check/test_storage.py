@@ -119,8 +119,8 @@ def test_slicing_wide_layers_changes_nothing(monkeypatch):
 
 
 def test_grown_arrays_keep_their_rows_and_read_zero_beyond():
-    """Grow grows its own mapping (mremap, no zero-fill by numpy): the rows written stay
-    through growth and trim, capacity never written reads 0 (the kernel's pages, not garbage),
+    """Grow starts as a heap block and crosses into its own mapping (mremap, no zero-fill by
+    numpy) from 1 MiB: the rows written stay through growth, the crossing and trim, capacity never written reads 0 (the kernel's pages, not garbage),
     and a view taken before the Grow is dropped still holds its memory."""
     g = Grow(np.uint8, 3, 2)
     rows = np.arange(3 * 5000, dtype=np.uint32).astype(np.uint8).reshape(-1, 3)
