@@ -84,6 +84,7 @@ class Tuning:
     avoid_sonar_m: float = T.NP3_AVOID_SONAR_M
     avoid_turn_s: float = T.NP3_AVOID_TURN_S
     avoid_keep_side_s: float = T.NP3_AVOID_KEEP_SIDE_S
+    avoid_square_deg: float = T.NP3_AVOID_SQUARE_DEG
     pit_back_s: float = T.NP3_PIT_BACK_S
     pit_turn_s: float = T.NP3_PIT_TURN_S
     tilt_limit_deg: float = T.NP3_TILT_LIMIT_DEG
@@ -438,12 +439,31 @@ def safe_instead(points: list[Point], cmd: Any, t: Tuning) -> Any:
 
 
 # --------------------------------------------------------------------------- level 1: avoidance
+def blocking_surface(points: list[Point], t: Tuning) -> Surface | None:
+    """The surface the remembered echoes in the legs' way (clear_ahead's corridor, up to avoid_echo_m from the
+    body centre) lie on: the line fitted through them (points all within a centimetre, e.g. one IR beam's
+    repeated reading: a surface facing the body at them); its normal says from which side it faces the body.
+    None when no echo is in the way."""
+    way = [(bx, by) for bx, by, _seen, arc in points
+           if t.body_half_length_m < bx < t.avoid_echo_m and abs(by) + arc < t.avoid_half_width_m]
+    if not way:
+        return None
+    mx, my = sum(p[0] for p in way) / len(way), sum(p[1] for p in way) / len(way)
+    if all(math.hypot(px - mx, py - my) < 0.01 for px, py in way):
+        return Surface(math.atan2(my, mx), math.hypot(mx, my))
+    return _line(way)
+
+
 def avoid_trigger(t: Tuning) -> Trigger:
     """seed 5.1.2: an obstacle ahead (IR centre or side beam, or the sonar looking ahead) -> turn away from it.
-    Without an IR beam to say which side is nearer, the side is chosen on the echo memory and then kept while
-    avoidance goes on (the next turn within avoid_keep_side_s): the sonar scans only ahead of the heading, so
-    after a turn the memory shows the side turned to as seen and the other as unknown, and choosing again
-    turned the robot back and forth in front of a wall (issue 17, scenarios/sonar_first.yaml)."""
+    Without an IR beam to say which side is nearer, the remembered echoes in the legs' way say it: turn away
+    from the side the surface they lie on faces the body from (blocking_surface). Only a surface met square on
+    leaves the side open; then it is chosen on the echo memory and kept while avoidance goes on (the next turn
+    within avoid_keep_side_s): the sonar scans only ahead of the heading, so after a turn the memory shows the
+    side turned to as seen and the other as unknown, and choosing again turned the robot back and forth in
+    front of a wall (issue 17, scenarios/sonar_first.yaml). Keeping the side whatever the surface turned the
+    robot into a corridor's wall it had come to face (corridor_narrow seed 2: three turns on to the right
+    towards the right-hand wall, the body across the corridor, its rear swung into the other wall)."""
     last: list[tuple[float, Any]] = []          # (when, turn) of the last avoidance turn
 
     def trigger(i: Mapping[str, Any], now: float) -> Steps | None:
@@ -457,8 +477,11 @@ def avoid_trigger(t: Tuning) -> Trigger:
                 or clear_ahead(pts, t.avoid_half_width_m, t.body_half_length_m) < t.avoid_echo_m)   # legs' corridor
         if not near:
             return None
+        surface = blocking_surface(pts, t)
         if left is not None or right is not None:
             turn = RIGHT if (left or math.inf) < (right or math.inf) else LEFT
+        elif surface is not None and abs(surface.normal_rad) >= math.radians(t.avoid_square_deg):
+            turn = RIGHT if surface.normal_rad > 0 else LEFT      # away from the side the surface faces it from
         elif last and now - last[0][0] <= t.avoid_turn_s + t.avoid_keep_side_s:
             turn = last[0][1]                  # still avoiding: on round the same way
         else:                                  # the side whose heading after the turn the memory shows clearer

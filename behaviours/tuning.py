@@ -85,6 +85,8 @@ NP3_AVOID_SIDE_M = 0.06       # ... or a side beam this close -> turn away
 NP3_AVOID_SONAR_M = 0.35      # ... or the sonar, looking ahead (+-15 deg), this close
 NP3_AVOID_TURN_S = 0.8        # one half cycle of turning per avoidance
 NP3_AVOID_KEEP_SIDE_S = 3.0   # ... the way it turned kept while the next comes within this (no dithering at a wall)
+NP3_AVOID_SQUARE_DEG = 10.0   # ... when the surface in the way faces the body within this of the heading (square
+                              # on); beyond it, away from the side it faces the body from
 NP3_SONAR_AHEAD_DEG = 15      # a sonar reading this close to the body axis counts as "ahead"
 NP3_SONAR_FRESH_S = 1.5       # ... while it is this recent
 NP3_PIT_BACK_S = 2.4          # pit (MMC NO_GROUND): back off ...

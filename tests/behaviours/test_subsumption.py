@@ -169,6 +169,29 @@ def test_avoidance_on_the_echo_memory_keeps_turning_the_way_it_started():
     assert net.step()["move"] == MovCmd.TURN_RIGHT
 
 
+def wall(normal_deg: float, dist_m: float) -> tuple[tuple[float, float, float, float], ...]:
+    """Echo points (body frame, seen straight on) of a straight wall whose normal from the body is at normal_deg."""
+    n = math.radians(normal_deg)
+    return tuple((dist_m * math.cos(n) - s / 20 * math.sin(n), dist_m * math.sin(n) + s / 20 * math.cos(n), 0.0, 0.0)
+                 for s in range(-8, 9))
+
+
+def test_avoidance_turns_away_from_the_side_the_surface_in_its_way_faces_it_from():
+    """issue 17, corridor_narrow seed 2: the robot had turned right away from the left-hand wall; the next echoes
+    in its way lay on the right-hand wall, facing it from the right, and avoidance kept turning right into it
+    (the body ended across the corridor, its rear swung into the other wall)."""
+    clock = FakeClock()
+    net = np3_network(clock, task="forward")
+    net.sense(pose=(0.0, 0.0, 0.0), echoes=wall(60.0, 0.25))       # the left wall, met at 30 deg
+    assert net.step()["move"] == MovCmd.TURN_RIGHT
+    net.sense(echoes=wall(-60.0, 0.25))                              # within the keep time: the right wall
+    clock.t = 0.9
+    assert net.step()["move"] == MovCmd.TURN_LEFT
+    net.sense(echoes=((0.25, 0.0, 0.0, 0.0),) * 3)                   # one IR point, read again and again: square
+    clock.t = 1.8                                                    # on, the side turned last is kept
+    assert net.step()["move"] == MovCmd.TURN_LEFT
+
+
 def test_wiring_table_lists_every_declared_connection():
     net = np3_network(FakeClock(), task="explore")
     table = net.wiring_table()
