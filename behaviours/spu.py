@@ -18,6 +18,7 @@ sensor that is not IN_ORDER is not trusted and its data is ignored (6.2).
 """
 from __future__ import annotations
 
+import math
 from typing import Any, NamedTuple, TypedDict
 
 from arachnae_proto import messages as M
@@ -29,7 +30,7 @@ from behaviours import tuning as T
 from behaviours.post import PostMaster
 from behaviours.runtime import PRIORITY_REFLEX, Runtime, slaves_of
 from behaviours.sensors import ABOVE, BELOW, BEYOND, AlarmLimit, limit_in
-from behaviours.units import XMIT_DATA_OF, age_byte, record_byte, values_quantizer
+from behaviours.units import RECORD_QUANTIZER, XMIT_DATA_OF, age_byte, record_byte, values_quantizer
 
 # each sensor role's STATUS_ACK layout; the range sensors are the ones with UNRELIABLE (3.2.11, 3.2.13)
 STATUS_OF = {role: cls for cls in (M.StatusAckRange, M.StatusAckOrder) for role in cls.SENDERS}
@@ -37,6 +38,7 @@ RANGE = tuple(M.StatusAckRange.SENDERS)
 _IN_ORDER, _OUT_OF_ORDER = int(RangeStatus.IN_ORDER), int(RangeStatus.OUT_OF_ORDER)   # same codes in ORDER_STATUS
 _VALUE, _ALARM, _STATUS = int(RecordKind.VALUE), int(RecordKind.ALARM), int(RecordKind.STATUS)
 _KIND_NAME = {int(k): k.name.lower() for k in RecordKind}
+_USRC = RECORD_QUANTIZER["USRC"]       # the echo's distance (m); its top code: nothing within range (3.2.11)
 
 
 def channels(role: str, msg: Any) -> dict[int, int]:
@@ -62,7 +64,11 @@ class SonarScan:
     """The angles (body frame, 0..359) of the sonar scan the SPU drives, one per poll (issue 17): the sweep ahead of
     the heading, and every SPU_SCAN_ROUND_EVERY-th angle one off it: mostly a side angle, the two sides in turn (a
     wall alongside needs an echo every few seconds: with the whole circle in turn a side came round every ~34 s
-    and wall_follow lost its wall at a corner), between them one step round the rest of the circle, for the map."""
+    and wall_follow lost its wall at a corner), between them one step round the rest of the circle, for the map.
+    While an echo from straight ahead (within SPU_SCAN_NEAR_DEG) is nearer than SPU_SCAN_NEAR_M, every angle is
+    one of the sweep (seed 5.1.2: find obstacles in time): a step off it had the ahead angles come round 1.2 s
+    apart with a wall 0.4 m ahead, and the avoidance's turn began so close that a whisker touched it
+    (sonar_first seed 11)."""
 
     def __init__(self) -> None:
         edge = max((abs(a) for a in T.SPU_SCAN_AHEAD_DEG), default=0)
@@ -71,10 +77,20 @@ class SonarScan:
         self.round = [a for a in range(edge + T.SPU_SCAN_ROUND_STEP_DEG, 360 - edge, T.SPU_SCAN_ROUND_STEP_DEG)
                       if a not in self.sides]
         self.steps = self.ahead_i = self.round_i = self.side_i = self.off_i = 0
+        self.ahead_m: dict[int, float] = {}       # the last echo (m, inf: none) at each angle straight ahead
+
+    def heard(self, angle: int, metres: float | None) -> None:
+        """An echo of the scan at `angle` (None: nothing within the sonar's range)."""
+        if abs((angle + 180) % 360 - 180) <= T.SPU_SCAN_NEAR_DEG:
+            self.ahead_m[angle % 360] = math.inf if metres is None else metres
+
+    def near(self) -> bool:
+        """Something straight ahead is near (seed 5.1.2): the scan stays on the sweep."""
+        return min(self.ahead_m.values(), default=math.inf) < T.SPU_SCAN_NEAR_M
 
     def next(self) -> int:
         self.steps += 1
-        if (self.round or self.sides) and self.steps % T.SPU_SCAN_ROUND_EVERY == 0:
+        if (self.round or self.sides) and self.steps % T.SPU_SCAN_ROUND_EVERY == 0 and not self.near():
             self.off_i += 1
             rest_turn = self.off_i % (T.SPU_SCAN_SIDES_PER_ROUND + 1) == 0
             if self.round and (rest_turn or not self.sides):
@@ -215,6 +231,7 @@ class SPU(PostMaster, Runtime, SpuSkeleton):
 
         def echo(s: int, m: M.XmitDataUsrc) -> None:
             if m.angle == angle and self.pinged_at is not None:    # else the measurement did not succeed
+                self.scan.heard(angle, None if m.distance >= _USRC.hi else _USRC.phys(m.distance))
                 self.got("USRC", m, False, self.pinged_at)
             else:
                 self.answered("USRC")

@@ -106,6 +106,21 @@ def test_the_sonar_scan_brings_each_side_round_often_and_still_covers_the_circle
     assert sum(a in ahead for a in angles) >= len(angles) * 0.6
 
 
+def test_the_sonar_scan_stays_ahead_while_something_straight_ahead_is_near():
+    """issue 17 (sonar_first seed 11): with a wall 0.43 m ahead a side step had the ahead angles come round 1.2 s
+    apart, the avoidance began so close that its turn swept a whisker into the wall. While an echo within
+    SPU_SCAN_NEAR_DEG of the heading is nearer than SPU_SCAN_NEAR_M, only the sweep; off it again once clear."""
+    sweep = {a % 360 for a in T.SPU_SCAN_AHEAD_DEG}
+    scan = SonarScan()
+    scan.heard(0, T.SPU_SCAN_NEAR_M - 0.2)
+    near = [scan.next() for _ in range(3 * T.SPU_SCAN_ROUND_EVERY)]
+    assert set(near) <= sweep
+    scan.heard(30, 0.3)                                   # beside the way (a corridor's wall): not "ahead"
+    for a in {a for a in sweep if abs((a + 180) % 360 - 180) <= T.SPU_SCAN_NEAR_DEG}:
+        scan.heard(a, None)                               # straight ahead clear again: the rest of the circle too
+    assert not set(scan.next() for _ in range(T.SPU_SCAN_ROUND_EVERY)) <= sweep
+
+
 def test_the_sonar_scan_sweeps_ahead_and_steps_round_the_circle(spec):
     """seed 3.2.11, issue 17: HEAD_SET_ABS, DO_MEASURE, XMIT_DATA per angle; most angles ahead of the heading."""
     rig, _ = spu(spec, until=8.0)
