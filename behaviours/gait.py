@@ -103,7 +103,6 @@ class Gait:
         self.scale = 1.0                             # gait clock speed (slowed on servo over-temperature)
         self.pending = True                          # re-phase when every foot is down
         self.paused = False
-        self.hurry_until = 0.0                       # the pattern's clock runs fast until then (`_swing_time`)
         self.gait_switches = 0
         self.pause_s = 0.0
         self.dt = T.MMC_CONTROL_S                    # the last clock step (gait seconds); the MMC steps at this period
@@ -177,18 +176,21 @@ class Gait:
         # react now (seed 5.2): stance feet carry on in the new direction from where they are,
         # swinging feet re-aim their touchdown; the phase is re-fitted once every foot is down,
         # unless the pattern can walk on in its rhythm
+        wait = self.pending or not self._keeps_rhythm(cmd, was)
         for leg in self.legs:
             pl = self.plans[leg]
             if pl.swing:
                 left = pl.t0 + pl.dur - self.t
                 if left >= T.GAIT_MIN_SWING * self.t_swing:   # else it lands where it aimed
                     x, y, z = self.target(leg)                  # re-aimed from where it is (as the LCP does)
-                    pl.pos, pl.z0, pl.t0, pl.dur = (x, y), z, self.t, left
                     pl.end = self.path(leg, 0.5) if cmd != STOP else self.neutral(leg)
+                    if wait:     # the stance feet drift while it flies: land as soon as a short swing could (issue 17)
+                        left = max(self._fly_time((x, y), pl.end), T.GAIT_MIN_SWING * left)
+                    pl.pos, pl.z0, pl.t0, pl.dur = (x, y), z, self.t, left
                     pl.cmd = cmd
             else:
                 pl.c = self._project(leg, pl.pos) if cmd != STOP else 0.0
-        self.pending = self.pending or not self._keeps_rhythm(cmd, was)
+        self.pending = wait
 
     def _keeps_rhythm(self, cmd: int, was: int) -> bool:
         """Walk on in the running pattern (no wait for every foot down) after a change from `was` to `cmd`.
@@ -232,7 +234,7 @@ class Gait:
                 end = self.path(leg, 0.5)
                 # its own clock (the phase may call it landed a tick early), but no faster than the shortest
                 # swing: a foot that lifted with stroke to spare (`_swing_time`) has further to fly back
-                left = max(self.t - pl.t0, self.dt, math.dist((x, y), end) / self.stroke * T.GAIT_MIN_SWING * self.t_swing)
+                left = max(self.t - pl.t0, self.dt, self._fly_time((x, y), end))
                 if left < T.GAIT_MIN_SWING * self.t_swing:    # barely lifted: straight back down, no higher
                     pl.lift = z
                 pl.pos, pl.z0, pl.t0, pl.dur = (x, y), z, self.t, left
@@ -285,13 +287,10 @@ class Gait:
                 if not pl.swing and due and up < self.max_up and self._may_lift(leg):   # never more feet up than the pattern lifts
                     up += 1
                     late = max(0.0, (self.phase - pl.next_lift) * self.cycle)
-                    self._lift(leg, max(self.t_swing * T.GAIT_MIN_SWING, self._swing_time() - late))
-                    if self.paused:
-                        self.hurry_until = max(self.hurry_until, pl.t0 + pl.dur)
+                    self._lift(leg, max(self.t_swing * T.GAIT_MIN_SWING, self.t_swing - late))
                     while pl.next_lift - 0.5 * dt / self.cycle <= self.phase:
                         pl.next_lift += 1.0
-        hurry = self.paused or self.t < self.hurry_until - 1e-9
-        self.phase += dt / self.cycle / (T.GAIT_MIN_SWING if hurry else 1.0)
+        self.phase += dt / self.cycle
         # stance: one rigid body motion for every stance foot, unless one would leave its workspace
         dc = dt / self.t_stance
         stance = [self.plans[leg] for leg in self.legs if not self.plans[leg].swing]
@@ -302,6 +301,10 @@ class Gait:
             for pl in stance:
                 pl.pos = self._move(pl.pos, dc)
                 pl.c -= dc
+
+    def _fly_time(self, start: tuple[float, float], end: tuple[float, float]) -> float:
+        """The least time (gait s) a swing may take from start to end: a stroke in the shortest swing's time."""
+        return math.dist(start, end) / self.stroke * T.GAIT_MIN_SWING * self.t_swing
 
     def _may_lift(self, leg: int) -> bool:
         """Every foot in the air is one the pattern lifts together with this one (a late lift-off after a
@@ -316,13 +319,6 @@ class Gait:
                 elif self.p.side(other) == self.p.side(leg) or self.p.hip(other)[0] == hx:
                     return False
         return True
-
-    def _swing_time(self) -> float:
-        """A new swing's time (gait s): while the body waits for a foot to get out of the way it is as short as
-        a late lift-off's, and the pattern's clock runs as much faster until those swings have landed (they
-        land at their place in the pattern; stance feet lift sooner, with stroke to spare), so a pause after a
-        re-phase lasts half as long (issue 17). Swings already in the air keep their time (the LCP has it)."""
-        return self.t_swing * (T.GAIT_MIN_SWING if self.paused else 1.0)
 
     def _lift(self, leg: int, dur: float) -> None:
         pl = self.plans[leg]
