@@ -287,10 +287,11 @@ class Gait:
                 if not pl.swing and due and up < self.max_up and self._may_lift(leg):   # never more feet up than the pattern lifts
                     up += 1
                     late = max(0.0, (self.phase - pl.next_lift) * self.cycle)
-                    self._lift(leg, max(self.t_swing * T.GAIT_MIN_SWING, self.t_swing - late))
+                    swing = self.t_swing / (self._catch_up() if self.paused else 1.0)
+                    self._lift(leg, max(self.t_swing * T.GAIT_MIN_SWING, swing - late))
                     while pl.next_lift - 0.5 * dt / self.cycle <= self.phase:
                         pl.next_lift += 1.0
-        self.phase += dt / self.cycle
+        self.phase += dt / self.cycle * (self._catch_up() if self.paused else 1.0)
         # stance: one rigid body motion for every stance foot, unless one would leave its workspace
         dc = dt / self.t_stance
         stance = [self.plans[leg] for leg in self.legs if not self.plans[leg].swing]
@@ -319,6 +320,18 @@ class Gait:
                 elif self.p.side(other) == self.p.side(leg) or self.p.hip(other)[0] == hx:
                     return False
         return True
+
+    def _catch_up(self) -> float:
+        """How much faster the pattern's clock runs, and swings started then are, while the body waits for a
+        foot to get out of the way (issue 17: the wait after a re-phase is that much shorter).
+
+        Stance feet do not move meanwhile, so every leg keeps its place in the pattern; a short swing still in
+        the air when the body walks on lands early and its stance then runs past the stroke's rear end by at
+        most what the swing saved, which must stay within GAIT_OVERRUN: so (1 - 1/k) t_swing <= GAIT_OVERRUN
+        t_stance, and never shorter than the shortest swing (tripod 1.18x, ripple 1.43x, wave 2x).
+        """
+        room = 1.0 - T.GAIT_OVERRUN * self.t_stance / self.t_swing
+        return 1.0 / max(T.GAIT_MIN_SWING, room)
 
     def _lift(self, leg: int, dur: float) -> None:
         pl = self.plans[leg]
@@ -355,8 +368,12 @@ class Gait:
 
         It lifts (duty - u) cycles from now (now, if u is past the duty) and runs out of stroke when the body
         has moved c + 1/2 + GAIT_OVERRUN strokes; the pauses add up, so the largest of these is the pattern's.
+        A foot lifting now with less than the shortest swing left of its place stays up that much longer than
+        the pattern says, holding back the next lift-off by as much.
         """
-        return max(0.0, max(0.0, self.duty - u) * self.cycle - (c + 0.5 + T.GAIT_OVERRUN) * self.t_stance)
+        if u >= self.duty:
+            return max(0.0, T.GAIT_MIN_SWING - (1.0 - u) / (1.0 - self.duty)) * self.t_swing
+        return max(0.0, (self.duty - u) * self.cycle - (c + 0.5 + T.GAIT_OVERRUN) * self.t_stance)
 
     def _fit(self, c: float, u: float) -> float:
         """Cost of a foot at stroke coordinate c taking the place u (cycles since its stance began) in the pattern."""

@@ -5,12 +5,14 @@ without a foot jumping or the body losing its support; five legs walk on (seed 6
 """
 from __future__ import annotations
 
+import copy
 import math
 
 import pytest
 
 from behaviours.gait import (BACKWARD, FORWARD, GAITS, RIPPLE, SIDESTEP_LEFT, SIDESTEP_RIGHT, STOP, TRIPOD,
                              TURN_LEFT, TURN_RIGHT, WAVE, Gait, pattern)
+from behaviours import tuning as T
 from behaviours.kinematics import ik
 from sim2d.robot import Robot
 from sim2d.robot_params import DEFAULT as P
@@ -162,3 +164,40 @@ def test_ripple_direction_change_costs_the_same_at_any_phase(write, first, then)
     nominal = w.gait.speed()[0] * 2.5
     assert min(moved) > 0.6 * nominal, moved
     assert max(moved) - min(moved) < 0.1 * nominal, moved
+
+
+# (gait, first, then): the eighth session's probes (wave backward -> turn, ripple turn -> sidestep, whose middle
+# legs cross), a turn after a straight line and back in each gait, and gait switches while walking (issue 17)
+PHASE_CASES = [(WAVE, BACKWARD, TURN_LEFT), (WAVE, TURN_LEFT, FORWARD), (WAVE, SIDESTEP_LEFT, TURN_RIGHT),
+               (RIPPLE, TURN_RIGHT, SIDESTEP_LEFT), (RIPPLE, FORWARD, TURN_LEFT), (RIPPLE, TURN_LEFT, BACKWARD),
+               (TRIPOD, FORWARD, TURN_LEFT), (TRIPOD, SIDESTEP_RIGHT, WAVE), (WAVE, FORWARD, RIPPLE)]
+
+
+@pytest.mark.parametrize("gait, first, then", PHASE_CASES)
+def test_a_command_change_pauses_at_most_one_swing_whatever_phase_it_lands_at(gait, first, then):
+    """A command change landing at any of 40 phases of the steady cycle pauses the body at most one swing and
+    one shortest swing (1.2 s) in the new pattern's first cycle and swing after it, and never lifts more feet
+    than the pattern does. Why that bound: the change waits for the feet in the air to land (at most one
+    swing), the re-phase then fits the lift-off order and phase to where the feet are so that the foot with
+    the least stroke left lifts first (`Gait._orders`, `_wait`), and while the body still waits, the
+    feet step fast (`_catch_up`): about one shortest swing more. Main paused up to 2.84 s of a wave's cycle
+    (wave L->F 0-2.5 s; issue 17: gaits_all_moves passed by where its keys landed)."""
+    g = Gait(P)
+    g.set_command(gait)
+    g.set_command(first)
+    g.advance(T.MMC_CONTROL_S)                             # the pattern is set at the first step
+    for _ in range(round(3 * g.cycle / T.MMC_CONTROL_S)):  # steady walking
+        g.advance(T.MMC_CONTROL_S)
+    phases, pauses = 40, []
+    for _ in range(phases):
+        h = copy.deepcopy(g)
+        before = h.pause_s
+        h.set_command(then)
+        new = then if then in GAITS else gait
+        for _ in range(round((P.half_cycle / (1 - pattern(new, P.legs)[0]) + P.half_cycle) / T.MMC_CONTROL_S)):
+            h.advance(T.MMC_CONTROL_S)
+            assert sum(h.in_swing(leg) for leg in h.legs) <= h.max_up
+        pauses.append(h.pause_s - before)
+        for _ in range(round(g.cycle / phases / T.MMC_CONTROL_S)):
+            g.advance(T.MMC_CONTROL_S)
+    assert max(pauses) <= (1 + T.GAIT_MIN_SWING) * P.half_cycle + 1e-9, [round(p, 2) for p in pauses]
