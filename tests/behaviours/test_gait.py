@@ -174,7 +174,7 @@ PHASE_CASES = [(WAVE, BACKWARD, TURN_LEFT), (WAVE, TURN_LEFT, FORWARD), (WAVE, S
 
 
 @pytest.mark.parametrize("gait, first, then", PHASE_CASES)
-def test_a_command_change_pauses_at_most_one_swing_whatever_phase_it_lands_at(gait, first, then):
+def test_a_command_change_pauses_at_most_a_swing_and_a_half_whatever_phase_it_lands_at(gait, first, then):
     """A command change landing at any of 40 phases of the steady cycle pauses the body at most one swing and
     one shortest swing (1.2 s) in the new pattern's first cycle and swing after it, and never lifts more feet
     than the pattern does. Why that bound: the change waits for the feet in the air to land (at most one
