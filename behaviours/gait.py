@@ -17,6 +17,13 @@ changes skip that wait, whose cost would depend on the phase the command
 lands at: a reversal walks the pattern backwards in place (`_reverse`; the
 next re-phase turns it the right way round again), and in the tripod and
 ripple a change between straight lines keeps the rhythm (`_keeps_rhythm`).
+Any other change costs a bounded time whatever the phase it lands at (issue 17;
+seed 5.2: react now): the feet in the air land as soon as a short swing can,
+the re-phase picks the phase and each side's lift-off order with the shortest
+pause (`_rephase`: a turn reverses one side's strokes, so the fixed order no
+longer fits), and while the body still waits for a foot the feet step faster
+(`_catch_up`). A late lift-off never puts up feet the pattern keeps apart
+(`_may_lift`).
 With a leg lost (seed 6.3 allows one) the remaining five walk a wave over five legs with a
 shorter stroke, the two feet on the lost leg's side spread to straddle it,
 so that four feet on the ground always keep the body statically stable.
@@ -233,7 +240,7 @@ class Gait:
                 x, y, z = self.target(leg)
                 end = self.path(leg, 0.5)
                 # its own clock (the phase may call it landed a tick early), but no faster than the shortest
-                # swing: a foot that lifted with stroke to spare (`_swing_time`) has further to fly back
+                # swing: a foot that lifted with stroke to spare (`_catch_up`) has further to fly back
                 left = max(self.t - pl.t0, self.dt, self._fly_time((x, y), end))
                 if left < T.GAIT_MIN_SWING * self.t_swing:    # barely lifted: straight back down, no higher
                     pl.lift = z
