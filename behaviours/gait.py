@@ -248,8 +248,9 @@ class Gait:
                 pl.end, pl.cmd = end, cmd
                 pl.next_lift = self.phase + left / self.cycle + self.duty
             else:
-                pl.c = -pl.c
-                pl.next_lift = self.phase + stance_so_far[leg]     # back to its new rear end in what its stance took
+                pl.c = -pl.c     # back to its new rear end in what its stance took; a foot that landed before its
+                # place in the pattern (a short swing) has taken less: its own stroke says how much (issue 17)
+                pl.next_lift = self.phase + min(stance_so_far[leg], (pl.c + 0.5) * self.duty)
 
     def drop_leg(self, leg: int) -> None:
         """A leg is lost (seed 6.3: five of six suffice): walk the five-legged wave from the next all-feet-down."""
