@@ -17,12 +17,20 @@ changes skip that wait, whose cost would depend on the phase the command
 lands at: a reversal walks the pattern backwards in place (`_reverse`; the
 next re-phase turns it the right way round again), and in the tripod and
 ripple a change between straight lines keeps the rhythm (`_keeps_rhythm`).
+Any other change costs a bounded time whatever the phase it lands at (issue 17;
+seed 5.2: react now): the feet in the air land as soon as a short swing can,
+the re-phase picks the phase and each side's lift-off order with the shortest
+pause (`_rephase`: a turn reverses one side's strokes, so the fixed order no
+longer fits), and while the body still waits for a foot the feet step faster
+(`_catch_up`). A late lift-off never puts up feet the pattern keeps apart
+(`_may_lift`).
 With a leg lost (seed 6.3 allows one) the remaining five walk a wave over five legs with a
 shorter stroke, the two feet on the lost leg's side spread to straddle it,
 so that four feet on the ground always keep the body statically stable.
 """
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -175,18 +183,21 @@ class Gait:
         # react now (seed 5.2): stance feet carry on in the new direction from where they are,
         # swinging feet re-aim their touchdown; the phase is re-fitted once every foot is down,
         # unless the pattern can walk on in its rhythm
+        wait = self.pending or not self._keeps_rhythm(cmd, was)
         for leg in self.legs:
             pl = self.plans[leg]
             if pl.swing:
                 left = pl.t0 + pl.dur - self.t
                 if left >= T.GAIT_MIN_SWING * self.t_swing:   # else it lands where it aimed
                     x, y, z = self.target(leg)                  # re-aimed from where it is (as the LCP does)
-                    pl.pos, pl.z0, pl.t0, pl.dur = (x, y), z, self.t, left
                     pl.end = self.path(leg, 0.5) if cmd != STOP else self.neutral(leg)
+                    if wait:     # the stance feet drift while it flies: land as soon as a short swing could (issue 17)
+                        left = max(self._fly_time((x, y), pl.end), T.GAIT_MIN_SWING * left)
+                    pl.pos, pl.z0, pl.t0, pl.dur = (x, y), z, self.t, left
                     pl.cmd = cmd
             else:
                 pl.c = self._project(leg, pl.pos) if cmd != STOP else 0.0
-        self.pending = self.pending or not self._keeps_rhythm(cmd, was)
+        self.pending = wait
 
     def _keeps_rhythm(self, cmd: int, was: int) -> bool:
         """Walk on in the running pattern (no wait for every foot down) after a change from `was` to `cmd`.
@@ -227,15 +238,19 @@ class Gait:
             pl = self.plans[leg]
             if pl.swing:                               # flies back to where it lifted off in what its swing has taken so far
                 x, y, z = self.target(leg)
-                left = max(self.t - pl.t0, self.dt)    # its own clock: the phase may call it landed a tick early
+                end = self.path(leg, 0.5)
+                # its own clock (the phase may call it landed a tick early), but no faster than the shortest
+                # swing: a foot that lifted with stroke to spare (`_catch_up`) has further to fly back
+                left = max(self.t - pl.t0, self.dt, self._fly_time((x, y), end))
                 if left < T.GAIT_MIN_SWING * self.t_swing:    # barely lifted: straight back down, no higher
                     pl.lift = z
                 pl.pos, pl.z0, pl.t0, pl.dur = (x, y), z, self.t, left
-                pl.end, pl.cmd = self.path(leg, 0.5), cmd
+                pl.end, pl.cmd = end, cmd
                 pl.next_lift = self.phase + left / self.cycle + self.duty
             else:
-                pl.c = -pl.c
-                pl.next_lift = self.phase + stance_so_far[leg]     # back to its new rear end in what its stance took
+                pl.c = -pl.c     # back to its new rear end in what its stance took; a foot that landed before its
+                # place in the pattern (a short swing) has taken less: its own stroke says how much (issue 17)
+                pl.next_lift = self.phase + min(stance_so_far[leg], (pl.c + 0.5) * self.duty)
 
     def drop_leg(self, leg: int) -> None:
         """A leg is lost (seed 6.3: five of six suffice): walk the five-legged wave from the next all-feet-down."""
@@ -274,16 +289,17 @@ class Gait:
             return
         if not self.pending:                                   # no new swing until every foot is down
             up = sum(1 for leg in self.legs if self.plans[leg].swing)
-            for leg in self.legs:
+            for leg in sorted(self.legs, key=lambda lg: self.plans[lg].next_lift):   # the most overdue first
                 pl = self.plans[leg]
                 due = self.phase >= pl.next_lift - 0.5 * dt / self.cycle      # on the tick nearest its time
-                if not pl.swing and due and up < self.max_up:   # never more feet up than the pattern lifts
+                if not pl.swing and due and up < self.max_up and self._may_lift(leg):   # never more feet up than the pattern lifts
                     up += 1
                     late = max(0.0, (self.phase - pl.next_lift) * self.cycle)
-                    self._lift(leg, max(self.t_swing * T.GAIT_MIN_SWING, self.t_swing - late))
+                    swing = self.t_swing / (self._catch_up() if self.paused else 1.0)
+                    self._lift(leg, max(self.t_swing * T.GAIT_MIN_SWING, swing - late))
                     while pl.next_lift - 0.5 * dt / self.cycle <= self.phase:
                         pl.next_lift += 1.0
-        self.phase += dt / self.cycle
+        self.phase += dt / self.cycle * (self._catch_up() if self.paused else 1.0)
         # stance: one rigid body motion for every stance foot, unless one would leave its workspace
         dc = dt / self.t_stance
         stance = [self.plans[leg] for leg in self.legs if not self.plans[leg].swing]
@@ -295,6 +311,36 @@ class Gait:
                 pl.pos = self._move(pl.pos, dc)
                 pl.c -= dc
 
+    def _fly_time(self, start: tuple[float, float], end: tuple[float, float]) -> float:
+        """The least time (gait s) a swing may take from start to end: a stroke in the shortest swing's time."""
+        return math.dist(start, end) / self.stroke * T.GAIT_MIN_SWING * self.t_swing
+
+    def _may_lift(self, leg: int) -> bool:
+        """Every foot in the air is one the pattern lifts together with this one (a late lift-off after a
+        re-phase, a reversal or a pause may not put up two feet the pattern keeps apart): the tripod's own
+        group; otherwise never two of one side, nor both front or both rear legs (`pattern`)."""
+        hx = self.p.hip(leg)[0]
+        for other in self.legs:
+            if other != leg and self.plans[other].swing:
+                if self.running == TRIPOD:
+                    if self.offset[other] != self.offset[leg]:
+                        return False
+                elif self.p.side(other) == self.p.side(leg) or self.p.hip(other)[0] == hx:
+                    return False
+        return True
+
+    def _catch_up(self) -> float:
+        """How much faster the pattern's clock runs, and swings started then are, while the body waits for a
+        foot to get out of the way (issue 17: the wait after a re-phase is that much shorter).
+
+        Stance feet do not move meanwhile, so every leg keeps its place in the pattern; a short swing still in
+        the air when the body walks on lands early and its stance then runs past the stroke's rear end by at
+        most what the swing saved, which must stay within GAIT_OVERRUN: so (1 - 1/k) t_swing <= GAIT_OVERRUN
+        t_stance, and never shorter than the shortest swing (tripod 1.18x, ripple 1.43x, wave 2x).
+        """
+        room = 1.0 - T.GAIT_OVERRUN * self.t_stance / self.t_swing
+        return 1.0 / max(T.GAIT_MIN_SWING, room)
+
     def _lift(self, leg: int, dur: float) -> None:
         pl = self.plans[leg]
         pl.swing, pl.t0, pl.dur, pl.z0 = True, self.t - self.dt, dur, 0.0   # the step began this tick
@@ -302,31 +348,75 @@ class Gait:
         pl.lift = self.swing_lift
 
     def _rephase(self) -> None:
-        """Choose the new pattern's phase that fits where the stance feet are (no foot overruns its stroke)."""
-        self.offset = pattern(self.running, self.legs)[1]      # the right way round again after a reversal
-        best, best_phi = math.inf, 0.0
-        for i in range(T.GAIT_REPHASE_STEPS):
-            phi = i / T.GAIT_REPHASE_STEPS
-            cost = 0.0
-            for leg in self.legs:
-                u = (phi - self.offset[leg]) % 1.0
-                c = self.plans[leg].c
-                if u < self.duty:                            # stance, (1 - s) strokes before lift-off
-                    s = u / self.duty
-                    over = max(0.0, -0.5 - (c - (1 - s)))
-                    cost += T.GAIT_OVERRUN_WEIGHT * over * over + (c - (0.5 - s)) ** 2
-                else:                                        # would lift now, with what is left of its swing
-                    s = (u - self.duty) / (1 - self.duty)
-                    if 1 - s < T.GAIT_MIN_SWING:
-                        cost += T.GAIT_OVERRUN_WEIGHT
-                    cost += (c + 0.5) ** 2 + s * s
-            if cost < best - 1e-12:
-                best, best_phi = cost, phi
+        """Choose the phase, and the lift-off order within each side, that fit where the stance feet are.
+
+        A turn after a straight line (or the other way round) reverses one side's strokes, so that
+        side's feet stand in the order opposite to the pattern's: no phase of the fixed order fits, and
+        the body paused until the foot due last had stepped, 0-2.6 s of a 4 s wave turn depending on the
+        phase the key came at (issue 17). Each side's legs may take each other's places in the pattern
+        (`_orders`): the feet up together stay as many, and on different sides, as the pattern has.
+        """
+        best, best_phi, best_offset = math.inf, 0.0, self.offset
+        for offset in self._orders():
+            for i in range(T.GAIT_REPHASE_STEPS):
+                phi = i / T.GAIT_REPHASE_STEPS
+                us = [(self.plans[leg].c, (phi - offset[leg]) % 1.0) for leg in self.legs]
+                cost = T.GAIT_PAUSE_WEIGHT * max(self._wait(c, u) for c, u in us) + sum(self._fit(c, u) for c, u in us)
+                if cost < best - 1e-12:
+                    best, best_phi, best_offset = cost, phi, offset
+        self.offset = best_offset
         self.phase = math.floor(self.phase) + 1.0 + best_phi
         for leg in self.legs:
             pl = self.plans[leg]
             u = (best_phi - self.offset[leg]) % 1.0
             pl.next_lift = self.phase - (u - self.duty) if u >= self.duty else self.phase + (self.duty - u)
+
+    def _wait(self, c: float, u: float) -> float:
+        """How long (gait s) the body must pause for a foot at stroke coordinate c in place u to lift in time.
+
+        It lifts (duty - u) cycles from now (now, if u is past the duty) and runs out of stroke when the body
+        has moved c + 1/2 + GAIT_OVERRUN strokes; the pauses add up, so the largest of these is the pattern's.
+        A foot lifting now with less than the shortest swing left of its place stays up that much longer than
+        the pattern says, holding back the next lift-off by as much.
+        """
+        if u >= self.duty:
+            return max(0.0, T.GAIT_MIN_SWING - (1.0 - u) / (1.0 - self.duty)) * self.t_swing
+        return max(0.0, (self.duty - u) * self.cycle - (c + 0.5 + T.GAIT_OVERRUN) * self.t_stance)
+
+    def _fit(self, c: float, u: float) -> float:
+        """Cost of a foot at stroke coordinate c taking the place u (cycles since its stance began) in the pattern."""
+        if u < self.duty:                            # stance, (1 - s) strokes before lift-off
+            s = u / self.duty
+            over = max(0.0, -0.5 - (c - (1 - s)))
+            return T.GAIT_OVERRUN_WEIGHT * over * over + (c - (0.5 - s)) ** 2
+        s = (u - self.duty) / (1 - self.duty)        # would lift now, with what is left of its swing
+        return (T.GAIT_OVERRUN_WEIGHT if 1 - s < T.GAIT_MIN_SWING else 0.0) + (c + 0.5) ** 2 + s * s
+
+    def _orders(self) -> list[dict[int, float]]:
+        """The running pattern's offsets (first: kept on a tie), then each side's legs in every order of its places.
+
+        Only patterns with one foot up per side at a time (ripple, wave) are reordered, and only where the
+        feet up together are still never both front or both rear legs (`pattern`); the tripod's groups and
+        the five-legged wave's straddle stay as they are.
+        """
+        base = pattern(self.running, self.legs)[1]     # the right way round again after a reversal
+        if self.running not in (RIPPLE, WAVE):
+            return [base]
+        sides = [[leg for leg in self.legs if self.p.side(leg) == sd] for sd in (1.0, -1.0)]
+        up = 1 - self.duty - 1e-9
+        orders = [base]
+        for left in itertools.permutations(sides[0]):
+            for right in itertools.permutations(sides[1]):
+                offset = {leg: base[slot] for legs, slots in ((left, sides[0]), (right, sides[1]))
+                          for leg, slot in zip(legs, slots)}
+                together = [(a, b) for a, b in itertools.combinations(self.legs, 2)
+                            if min((offset[a] - offset[b]) % 1.0, (offset[b] - offset[a]) % 1.0) < up]
+                if offset != base and all(self.p.hip(a)[0] != self.p.hip(b)[0] for a, b in together):
+                    orders.append(offset)
+        if self.max_up == 1:       # one foot up at a time: any order keeps five down; the nearest its rear end first
+            urgent = sorted(self.legs, key=lambda leg: self.plans[leg].c)
+            orders.append({leg: base[slot] for leg, slot in zip(urgent, sorted(base, key=base.__getitem__))})
+        return orders
 
     def set_scale(self, scale: float) -> None:
         """Slow the whole gait down (servo over-temperature) or back to full speed."""

@@ -25,6 +25,7 @@ GAIT_MIN_SWING = 0.5          # a swing never lasts less than half its normal ti
                               # and is re-aimed at a new direction's touchdown only with at least that much time left
 GAIT_REPHASE_STEPS = 48       # candidate phases tried when fitting a new gait to where the feet are
 GAIT_OVERRUN_WEIGHT = 100.0   # cost of an overrun (per stroke squared) against a merely short or long step
+GAIT_PAUSE_WEIGHT = 1e4       # cost of each second the body would pause for a re-phased foot to lift (minimax first)
 GAIT_FIVE_LEG_STROKE = 0.5    # five legs: half the stroke, so four feet always hold the body inside their polygon
 GAIT_FIVE_LEG_SPREAD = 0.5    # five legs: the two feet on the lost leg's side stand at +-this x the front hip's x
 
