@@ -32,7 +32,8 @@ from behaviours import tuning as T
 from behaviours.np3_layers import (AVOIDANCE, REFLEXES, Tuning, body_frame, closing_in, np3_network, safe_instead,
                                    steepness_deg, uphill)
 from behaviours.runtime import Runtime
-from behaviours.topomap import OCCUPIED, FrontierTarget, OccupancyGrid, Reading, TopoMap, ray_cells
+from behaviours.topomap import (OCCUPIED, FrontierTarget, HeadingVotes, OccupancyGrid, Reading, TopoMap, heading_offset,
+                                ray_cells)
 from behaviours.units import RECORD_QUANTIZER, Quantizer, from_record_byte
 
 _VALUE, _ALARM, _STATUS = int(RecordKind.VALUE), int(RecordKind.ALARM), int(RecordKind.STATUS)
@@ -43,6 +44,7 @@ _LEFT, _RIGHT = int(MovCmd.TURN_LEFT), int(MovCmd.TURN_RIGHT)
 _SIDE_L, _SIDE_R = int(MovCmd.SIDESTEP_LEFT), int(MovCmd.SIDESTEP_RIGHT)
 # the encoding each source role's records carry (spec messages.<m>.record_values)
 _Q: dict[str, Quantizer] = RECORD_QUANTIZER
+_PLANNING = ("explore", "seek_light")      # the tasks that plan routes over the map (3.3.2) and so keep it true
 
 
 def decode(role: str, value: int) -> float:
@@ -87,6 +89,7 @@ class Np3Map(TypedDict):
     edges: int
     routes: int
     seen_m2: float
+    heading_fixed_deg: float      # the heading corrections from the map, summed
 
 
 class Np3Light(TypedDict, total=False):      # empty before the first light reading
@@ -151,6 +154,8 @@ class NP3(Runtime, Np3Skeleton):
         self.routes_planned = 0               # routes planned over the topological map (3.3.2)
         self.frontier_target = FrontierTarget(T.NP3_PLAN_EXCLUDE_M, T.NP3_PLAN_PROGRESS_M, T.NP3_PLAN_PATIENCE_S)
         self.visited: set[tuple[int, int]] = set()
+        self.heading_votes = HeadingVotes(T.NP3_MATCH_VOTES, T.NP3_MATCH_GAIN, math.radians(T.NP3_MATCH_STEP_DEG))
+        self.heading_fixed = 0.0              # the heading corrections from the map, summed (rad, debug metrics)
         self.last_cell: tuple[int, int] | None = None
         self.every(T.NP3_PERIOD_S, self.tick)
 
@@ -185,7 +190,7 @@ class NP3(Runtime, Np3Skeleton):
             g = self.map.grid
             self.layers.sense(mapped=tuple((mx, my, 0.0, g.res / 2)
                                            for mx, my in g.occupied_near(x, y, T.NP3_MAPPED_NEAR_M)))
-        if self.cfg.task in ("explore", "seek_light"):     # seeking light explores while it is dark
+        if self.cfg.task in _PLANNING:                   # seeking light explores while it is dark
             self.mark_visited(x, y)
             goal = self.goal
             if now >= self.next_plan or (goal is not None and math.hypot(goal[0] - x, goal[1] - y)
@@ -462,8 +467,26 @@ class NP3(Runtime, Np3Skeleton):
         if d is not None and d < T.NP3_ECHO_NEAR_M:
             self.echo(0.0, 0.0, rel, d, T.NP3_SONAR_BEAM_DEG)
         half, n = T.NP3_SONAR_BEAM_DEG / 2, 5
+        if self.cfg.task in _PLANNING and d is not None and T.NP3_MATCH_RANGE_M[0] <= d <= T.NP3_MATCH_RANGE_M[1]:
+            off = heading_offset(self.map.grid, x, y, th + math.radians(head_deg), d, T.NP3_SONAR_BEAM_DEG, n,
+                                 T.NP3_MATCH_SEARCH_DEG, T.NP3_MATCH_TOL_M, T.NP3_MATCH_WIDTH_DEG)
+            if off is not None:
+                self.correct_heading(self.heading_votes.add(off))
+                th = self.odo.th
         cone = [Reading(x, y, math.degrees(th), head_deg - half + 2 * half * k / (n - 1), d) for k in range(n)]
         self.map.add(cone)
+
+    def correct_heading(self, turn: float) -> None:
+        """seed 3.3.2: the map says the dead-reckoned heading is `turn` rad off: turn it, and the echoes in the
+        local memory with it about the robot (they were placed with the old heading)."""
+        if not turn:
+            return
+        x, y, _ = self.odo.pose
+        self.odo.th = (self.odo.th + turn + math.pi) % (2 * math.pi) - math.pi
+        c, s = math.cos(turn), math.sin(turn)
+        self.echoes = deque((t, x + (ex - x) * c - (ey - y) * s, y + (ex - x) * s + (ey - y) * c, *rest)
+                            for t, ex, ey, *rest in self.echoes)
+        self.heading_fixed += turn
 
     # --- debug port --------------------------------------------------------------------------------
     def debug_metrics(self) -> Np3Debug:
@@ -484,7 +507,8 @@ class NP3(Runtime, Np3Skeleton):
             "ir_fault": self.ir_fault,
             "sonar_ignored": self.sonar_ignored,
             "map": {"places": len(self.map.places), "edges": len(self.map.edges), "routes": self.routes_planned,
-                    "seen_m2": round(sum(self.map.grid.seen) * self.map.grid.res ** 2, 2)},
+                    "seen_m2": round(sum(self.map.grid.seen) * self.map.grid.res ** 2, 2),
+                    "heading_fixed_deg": round(math.degrees(self.heading_fixed), 1)},
             "light": {"first_lux": round(self.lux[0], 1), "last_lux": round(self.lux[-1], 1),
                       "ratio": round(self.lux[-1] / self.lux[0], 3)} if self.lux else {},
         }
