@@ -10,7 +10,10 @@ scheduling (3.2.2): XMIT_REQ, then MOVE when the MCP grants the bus.
 
 Beside the network the node keeps a dead-reckoned pose (CHOICE: from its own
 MOVE commands and the gait's measured speeds) and the topological map of
-seed 3.3.2, built from the USRC's echoes (channel = head angle); exploring
+seed 3.3.2, built from the USRC's echoes (channel = head angle). The tasks that
+plan on the map correct the pose's heading from it: echoes of mapped surfaces
+vote for the heading under which the map predicts them (topomap.HeadingVotes;
+no compass is declared, and the behaviours never read the simulator's pose); exploring
 heads along the map's least-passed open ray. A short local memory of echoes
 (sonar, IR, whiskers) at the DR pose lets wall following and avoidance see
 what the sensors saw seconds ago. debug_metrics() reports which layer held the
