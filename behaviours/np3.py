@@ -237,8 +237,7 @@ class NP3(Runtime, Np3Skeleton):
 
         First choice: the heading whose ray through the map runs longest over cells not passed yet before a
         mapped obstacle, with a goal along it (short of the obstacle). When no heading is open (boxed in by
-        walls, pits, refused slopes), every open heading runs over cells passed already for less than
-        NP3_EXPLORE_FRESH_MIN_M (the explored end of a maze's corridor), or a route is being followed, a route over the topological map to the
+        walls, pits, refused slopes) or a route is being followed, a route over the topological map to the
         nearest frontier (free space bordering unknown space, at least NP3_PLAN_MIN_PATH_M away), waypoint
         by waypoint; it is planned again (the map has changed) every NP3_EXPLORE_PLAN_S.
         (Measured, issue 17: frontier routes as the first choice covered less of the explore room, 0.36-0.40
@@ -266,7 +265,7 @@ class NP3(Runtime, Np3Skeleton):
                 self.layers.sense(goal=self.goal)
                 return
         g = self.map.grid
-        best: tuple[float, float, float, float] | None = None   # (score, heading, free length, not passed)
+        best: tuple[float, float, float] | None = None          # (score, heading, free length)
         for k in range(T.NP3_EXPLORE_HEADINGS):
             turn = (2 * math.pi * k / T.NP3_EXPLORE_HEADINGS + math.pi) % (2 * math.pi) - math.pi
             h = th + turn
@@ -278,13 +277,12 @@ class NP3(Runtime, Np3Skeleton):
                 fresh += g.res * (cell not in self.visited)
             score = fresh + 0.2 * free - 0.3 * abs(turn)
             if free > T.NP3_EXPLORE_MARGIN_M and (best is None or score > best[0]):
-                best = (score, h, free, fresh)
-        self.goal = None
-        if best is None or best[3] < T.NP3_EXPLORE_FRESH_MIN_M:   # boxed in, or all round passed already (a maze's
-            self.goal = self.route_to_frontier(x, y, now)           # dead end): a route to the unknown, if any
-        if best is not None and self.goal is None:
+                best = (score, h, free)
+        if best is not None:
             length = min(best[2] - T.NP3_EXPLORE_MARGIN_M, T.NP3_EXPLORE_GOAL_M)
             self.goal = (x + length * math.cos(best[1]), y + length * math.sin(best[1]))
+        else:
+            self.goal = self.route_to_frontier(x, y, now)
         self.layers.sense(goal=self.goal)
 
     def route_to_frontier(self, x: float, y: float, now: float, size_weight: float = 0.0) \

@@ -105,9 +105,7 @@ NP3_EXPLORE_HEADINGS = 16     # ... the best of this many headings round the rob
 NP3_EXPLORE_REACH_M = 3.0     # ... the cells not yet passed along the ray, up to this far, before an obstacle;
 NP3_EXPLORE_MARGIN_M = 0.5    # ... the goal stays this far short of the obstacle
 NP3_EXPLORE_GOAL_M = 2.0      # ... and at most this far away
-NP3_EXPLORE_SEEN_M = 0.5      # ... cells within this of the path count as passed; when the best heading has less
-NP3_EXPLORE_FRESH_MIN_M = 1.0 # ... than this not passed, a route to the nearest frontier instead (a maze's explored
-                              # corridor: maze_far_room seed 3 kept to its first two for 300 s, issue 17)
+NP3_EXPLORE_SEEN_M = 0.5      # ... cells within this of the path count as passed
 NP3_EXPLORE_WANDER_S = 12.0   # explore without a goal: a new heading every 12 s ...
 NP3_EXPLORE_TURN_S = 2.4      # ... turning this long
 NP3_GOAL_REACHED_M = 0.4      # a goal this close (dead reckoning) is reached
