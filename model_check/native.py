@@ -46,6 +46,14 @@ from model_check.gcl import Model
 from model_check.storage import LOAD, StateStore
 
 CC_FLAGS = ("-O1", "-shared", "-fPIC", "-std=c99", "-w")
+# more compiler flags from the environment, for measurements and checks (e.g. "-DPSTAT": the
+# parallel search's phase timers printed at exit; "-fsanitize=address,undefined"); part of the cache key
+EXTRA_FLAGS_ENV = "ARACHNAE_NATIVE_CFLAGS"
+
+
+def cc_flags() -> tuple[str, ...]:
+    """CC_FLAGS and the environment's extra flags."""
+    return CC_FLAGS + tuple(os.environ.get(EXTRA_FLAGS_ENV, "").split())
 HIT_NONE, HIT_INVARIANT, HIT_DEADLOCK, HIT_RANGE, HIT_FULL = 0, 1, 2, 3, 4
 MAX_EDGES = 1 << 16       # edges per call at most: bounds the buffers (about 3 MB for 3-word states)
 
@@ -102,6 +110,7 @@ def _c(node: ast.expr, name) -> str:
 
 
 _PRELUDE = """\
+#define _GNU_SOURCE           /* syscall (the parallel search's futex), clock_gettime (PSTAT) */
 #include <stdint.h>
 #include <string.h>
 typedef int64_t I;
@@ -242,43 +251,78 @@ out:
 
 # The parallel search (model_check.parallel): `prun`, called on every thread at once (thread t),
 # runs rounds over `bfs`'s hash table and rows until the search ends, a hit, `rounds` rounds, or
-# arrays to grow; threads meet at barriers in C (no Python between the steps). A round: thread 0
-# cuts the next states into consecutive slices (several per thread); then, the threads taking
-# the slices as they come free (ptake), each slice
+# arrays to grow; threads meet at barriers in C (no Python between the steps; a short spin, then
+# a futex sleep). A round: thread 0 settles the last round and cuts the next states into
+# consecutive slices (several per thread); then, the threads taking the slices as they come free
+# (ptake), each slice
 # - is expanded against the table as it is, read only; a successor not in it becomes a
 #   candidate, deduplicated in the slice's own table, with its hash and where its probe of the
 #   shared table stopped (slot, step);
+# then (a barrier) each slice, in the same step (pput):
 # - (kept if every slice before it finished) has its candidates marked: one an earlier slice has too is
 #   that slice's (the earliest), the others are new, numbered in first-seen order;
-# - (thread 0: each slice's base id is the stored states plus the new ones of the slices before)
-#   writes each new candidate's row and parent at base + number and claims a table slot for its
-#   id with a compare-and-swap from where its probe stopped (the slots before it stay taken), and
-#   its edges, each candidate turned into its id, at their place in the store.
+# - takes its base id and edge place after the slice before it (the stored states plus the new
+#   ones of the slices before), then writes each new candidate's row and parent at base + number
+#   and claims a table slot for its id with a compare-and-swap from where its probe stopped (the
+#   slots before it stay taken), and its edges, each candidate turned into its id, at their
+#   place in the store.
+# Three barriers a round (plan, expand, put). Table slots are prefetched a few candidates ahead
+# (the claim and the mark stall on misses otherwise).
 _PARALLEL = """\
 #include <sched.h>
+#ifdef __linux__
+#include <linux/futex.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#endif
 typedef struct {
     int32_t *ev; RULE_T *er; uint8_t *crow; int32_t *cpar; U *chash; int64_t *cslot, *cstep;
     int32_t *clocal, *ltable, *cown, *cidx;
-    int64_t lbits, a, b, edge0, fresh, base, kept;
+    int64_t lbits, a, b, edge0, fresh, base, kept, ready;
     Res r;
 } Slice;
 typedef struct {
     uint8_t *keys; int32_t *parent, *table, *dst; RULE_T *rules; uint16_t *degree;
     int64_t width, tbits, tlimit, kcap, ecap, dcap, nk, ne, i, workers, edges_max, narrow, fan,
             seen_states, seen_edges, rounds, status, cap, bcount, bsense, nrounds, nsplit, ndropped,
-            nslices, cexp, cmark, cins;
+            nslices, cexp, cmark, bsleep;
     Res hit;
 } Ctx;
 enum { P_RUN, P_DONE, P_PAUSE, P_GROW, P_HIT };
+/* the threads meet: a short spin (a round's threads usually arrive within microseconds), then
+   a sleep on a futex (Linux; sched_yield elsewhere), so a thread waiting for one that other load
+   holds up gives its core away instead of spinning on it. bsense's low half is the futex word
+   (little-endian rows: Builder); bsleep counts the sleepers, so the last thread makes a wake
+   call only when one sleeps (its store and load, and a sleeper's count and the kernel's check
+   of the word, are sequentially consistent: no wake is lost). */
+#define SPIN 2000
+static inline void prelax(void) {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+}
 static void pbarrier(Ctx *c, int64_t *sense) {
     int64_t s = !*sense;
     *sense = s;
     if (__atomic_add_fetch(&c->bcount, 1, __ATOMIC_ACQ_REL) == c->workers) {
         __atomic_store_n(&c->bcount, 0, __ATOMIC_RELAXED);
-        __atomic_store_n(&c->bsense, s, __ATOMIC_RELEASE);
-    } else
-        for (int k = 0; __atomic_load_n(&c->bsense, __ATOMIC_ACQUIRE) != s; k++)
-            if (k > 100) sched_yield();
+        __atomic_store_n(&c->bsense, s, __ATOMIC_SEQ_CST);
+#ifdef __linux__
+        if (__atomic_load_n(&c->bsleep, __ATOMIC_SEQ_CST))
+            syscall(SYS_futex, (int32_t *)&c->bsense, FUTEX_WAKE_PRIVATE, INT32_MAX, NULL, NULL, 0);
+#endif
+        return;
+    }
+    for (int k = 0; __atomic_load_n(&c->bsense, __ATOMIC_ACQUIRE) != s; k++) {
+        if (k < SPIN) { prelax(); continue; }
+#ifdef __linux__
+        __atomic_add_fetch(&c->bsleep, 1, __ATOMIC_SEQ_CST);
+        syscall(SYS_futex, (int32_t *)&c->bsense, FUTEX_WAIT_PRIVATE, (int32_t)!s, NULL, NULL, 0);
+        __atomic_sub_fetch(&c->bsleep, 1, __ATOMIC_SEQ_CST);
+#else
+        sched_yield();
+#endif
+    }
 }
 static void pexpand(const Ctx *c, Slice *q) {
     int64_t tbits = c->tbits;
@@ -286,8 +330,10 @@ static void pexpand(const Ctx *c, Slice *q) {
     U succ[NRULES * W]; int32_t sr[NRULES];
     uint8_t tb[W * 8];
     const uint8_t *keys = c->keys;
+    const int32_t *table = c->table;
     int64_t ne = 0, nc = 0, i = q->a;
     Res *r = &q->r;
+    for (int64_t d = 0; d < r->distinct; d++) q->ltable[q->clocal[d]] = -1;   /* last round's: empty again */
     r->kind = 0;
     for (; i < q->b; i++) {
         if (ne + NRULES > c->cap) { r->kind = HIT_FULL; break; }
@@ -295,14 +341,15 @@ static void pexpand(const Ctx *c, Slice *q) {
         memcpy(s, keys + (size_t)i * KW, KW);      /* little-endian rows (Builder) */
         int64_t k = visit(s, succ, sr, r);
         if (k < 0) break;
+        SUCC_SLOTS();
         for (int64_t j = 0; j < k; j++) {
             const U *t = succ + (size_t)j * W;
-            HASH_SLOT();
+            U hh = hs_[j], slot = hh >> (64 - tbits);
             memcpy(tb, t, KW);
             int32_t got = -1;
             U step = 1;
             for (;; step++) {
-                int32_t g = c->table[slot];
+                int32_t g = table[slot];
                 if (g < 0) break;
                 if (keq(keys + (size_t)g * KW, tb)) { got = g; break; }
                 slot = (slot + step) & tmask;
@@ -339,6 +386,8 @@ static int64_t pmark(const Ctx *c, Slice *sl, int64_t t) {
     for (int64_t d = 0; d < q->r.distinct; d++) {
         const uint8_t *tb = q->crow + (size_t)d * KW;
         int32_t own = (int32_t)t, at = -1;
+        if (d + PF < q->r.distinct)         /* the slots PF candidates on, asked of memory now */
+            for (int64_t u = 0; u < t; u++) __builtin_prefetch(&sl[u].ltable[q->chash[d + PF] & lmask]);
         for (int64_t u = 0; u < t && at < 0; u++) {
             U ls = q->chash[d] & lmask;
             for (U lstep = 1;; lstep++) {
@@ -364,20 +413,21 @@ static inline void pclaim(int32_t *table, U slot, U step, U tmask, int32_t id) {
         slot = (slot + step) & tmask;
     }
 }
+/* slots lo .. hi-1 of a new table emptied (-1) on one of several threads, before any prehash */
+void pfill(int32_t *table, int64_t lo, int64_t hi) {
+    memset(table + lo, 0xff, (size_t)(hi - lo) * sizeof *table);
+}
 /* rehash's part lo .. hi-1 on one of several threads at once (the slot order may differ) */
+#define PPLACE(SLOT, ID) pclaim(table, (SLOT), 1, tmask, (ID))
 void prehash(const uint8_t *keys, int64_t lo, int64_t hi, int32_t *table, int64_t tbits) {
-    U tmask = ((U)1 << tbits) - 1, t[W];
-    for (int64_t i = lo; i < hi; i++) {
-        memset(t, 0, sizeof t);
-        memcpy(t, keys + (size_t)i * KW, KW);
-        HASH_SLOT();
-        pclaim(table, slot, 1, tmask, (int32_t)i);
-    }
+    U tmask = ((U)1 << tbits) - 1;
+    REHASH_LOOP(PPLACE);
 }
 static void pinsert(const Ctx *c, Slice *sl, int64_t t) {
     Slice *q = &sl[t];
     U tmask = ((U)1 << c->tbits) - 1;
     for (int64_t d = 0; d < q->r.distinct; d++) {
+        if (d + PF < q->r.distinct) __builtin_prefetch(&c->table[q->cslot[d + PF]], 1);  /* as pmark */
         if (q->cown[d] != t) continue;
         int32_t id = (int32_t)(q->base + q->cidx[d]);
         memcpy(c->keys + (size_t)id * KW, q->crow + (size_t)d * KW, KW);
@@ -399,7 +449,8 @@ static void pinsert(const Ctx *c, Slice *sl, int64_t t) {
 /* thread 0, before a round: the slices, or why not (the search is over, arrays to grow, a pause) */
 static void pplan(Ctx *c, Slice *sl) {
     int64_t n = c->nslices;
-    c->cmark = 0;
+    c->cexp = c->cmark = 0;
+    for (int64_t u = 0; u < n; u++) sl[u].ready = 0;
     if (c->status != P_RUN) return;
     if (c->i == c->nk) { c->status = P_DONE; return; }
     if (c->rounds-- <= 0) { c->status = P_PAUSE; return; }
@@ -418,13 +469,12 @@ static void pplan(Ctx *c, Slice *sl) {
     }
     c->cap = cap;
 }
-/* thread 0, after the marks: bases and edge places of the kept slices, the counts, a hit */
+/* thread 0, after a round: the counts, a hit */
 static void psettle(Ctx *c, Slice *sl) {
     int64_t nk = c->nk, ne = c->ne, last = 0, busy = 0;
-    c->cexp = c->cins = 0;
     for (int64_t u = 0; u < c->nslices && sl[u].kept; u++) {
-        sl[u].base = nk; nk += sl[u].fresh;
-        sl[u].edge0 = ne; ne += sl[u].r.edges;
+        nk += sl[u].fresh;
+        ne += sl[u].r.edges;
         last = u;
     }
     for (int64_t u = 0; u < c->nslices; u++) busy += sl[u].a < sl[u].b;
@@ -435,14 +485,15 @@ static void psettle(Ctx *c, Slice *sl) {
     c->seen_states += r->done - sl[0].a;
     c->seen_edges += ne - c->ne;
     c->nk = nk; c->ne = ne; c->i = r->done;
-    /* successors per state to plan for: twice the highest mean of this round's slices; after a
-       round that dropped slices, twice what was planned */
+    /* successors per state to plan for: twice the highest mean of this round's slices, at least
+       7/8 of the last round's plan; after a round that dropped slices, twice what was planned */
     int64_t fan = 1;
     for (int64_t u = 0; u <= last; u++) {
         int64_t m = sl[u].r.done > sl[u].a ? (2 * sl[u].r.edges + sl[u].r.done - sl[u].a - 1) / (sl[u].r.done - sl[u].a) : 1;
         if (m > fan) fan = m;
     }
     if (busy > last + 1) fan = 2 * c->fan;
+    else if (fan < c->fan - c->fan / 8) fan = c->fan - c->fan / 8;    /* down slowly: fewer drops (158 -> 53 of 988 rounds) */
     c->fan = fan > NRULES ? NRULES : fan;
     if (r->kind != 0 && r->kind != HIT_FULL) { c->hit = *r; c->status = P_HIT; }
 }
@@ -452,30 +503,68 @@ static inline int64_t ptake(const Ctx *c, int64_t *next) {
     int64_t k = __atomic_fetch_add(next, 1, __ATOMIC_RELAXED);
     return k < c->nslices ? k : -1;
 }
+#ifdef PSTAT    /* phase timers (ARACHNAE_NATIVE_CFLAGS=-DPSTAT): wall and CPU ns per thread, printed at exit */
+#include <stdio.h>
+#include <time.h>
+enum { S_PLAN, S_EXPAND, S_INSERT, S_WAIT, S_N };
+static const char *SNAME[S_N] = {"settle+plan", "expand", "mark+insert", "barrier"};
+static int64_t swall[8][S_N], scpu[8][S_N];
+static int64_t sedges, scand, sfresh, skept;     /* edges and candidates expanded, new states, edges kept */
+#define PCOUNT(X, N) __atomic_add_fetch(&(X), (N), __ATOMIC_RELAXED)
+static int64_t snow(clockid_t k) { struct timespec ts; clock_gettime(k, &ts); return ts.tv_sec * 1000000000LL + ts.tv_nsec; }
+#define PT(T, PH, STMT) do { int64_t w0_ = snow(CLOCK_MONOTONIC), c0_ = snow(CLOCK_THREAD_CPUTIME_ID); STMT; \
+    if ((T) < 8) { swall[T][PH] += snow(CLOCK_MONOTONIC) - w0_; scpu[T][PH] += snow(CLOCK_THREAD_CPUTIME_ID) - c0_; } } while (0)
+__attribute__((destructor)) static void sprint(void) {
+    for (int t = 0; t < 8; t++) {
+        int64_t any = 0;
+        for (int h = 0; h < S_N; h++) any += swall[t][h];
+        if (!any) continue;
+        fprintf(stderr, "PSTAT thread %d:", t);
+        for (int h = 0; h < S_N; h++) fprintf(stderr, " %s %.3f/%.3f", SNAME[h], swall[t][h] / 1e9, scpu[t][h] / 1e9);
+        fprintf(stderr, " (wall/cpu s)\\n");
+    }
+    if (sedges) fprintf(stderr, "PSTAT edges expanded %lld (kept %lld), candidates %lld, new states %lld\\n",
+                        (long long)sedges, (long long)skept, (long long)scand, (long long)sfresh);
+}
+#else
+#define PT(T, PH, STMT) do { STMT; } while (0)
+#define PCOUNT(X, N) ((void)0)
+#endif
+/* slice k after the expansion: whether it is kept, its candidates marked, its base id and edge
+   place (after slice k-1's: waits until that slice has them, taken before k and in hand), then
+   its rows, table slots and edges; marking reads the tables of the slices before, so a slice's
+   table is emptied at its next expansion */
+static void pput(Ctx *c, Slice *sl, int64_t k) {
+    Slice *q = &sl[k];
+    q->kept = q->a < q->b;
+    for (int64_t u = 0; u < k; u++) if (sl[u].r.done < sl[u].b) q->kept = 0;
+    q->fresh = q->kept ? pmark(c, sl, k) : 0;
+    if (k == 0) { q->base = c->nk; q->edge0 = c->ne; }
+    else {
+        const Slice *p = &sl[k - 1];
+        for (int w = 0; !__atomic_load_n(&p->ready, __ATOMIC_ACQUIRE); w++)
+            if (w < SPIN) prelax(); else sched_yield();
+        q->base = p->base + p->fresh;
+        q->edge0 = p->edge0 + (p->kept ? p->r.edges : 0);
+    }
+    __atomic_store_n(&q->ready, 1, __ATOMIC_RELEASE);
+    PCOUNT(sedges, q->r.edges); PCOUNT(scand, q->r.distinct); PCOUNT(sfresh, q->fresh); PCOUNT(skept, q->kept ? q->r.edges : 0);
+    if (q->kept) pinsert(c, sl, k);
+    else q->r.edges = 0;
+}
+/* rounds: thread 0 plans (after settling the last round), then every thread expands slices,
+   then marks and puts them: two barriers a round after the plan's */
 void prun(Ctx *c, Slice *sl, int64_t t) {
     int64_t sense = 0, k;
     for (;;) {
-        if (t == 0) pplan(c, sl);
-        pbarrier(c, &sense);
+        if (t == 0) PT(t, S_PLAN, pplan(c, sl));
+        PT(t, S_WAIT, pbarrier(c, &sense));
         if (c->status != P_RUN) return;
-        while ((k = ptake(c, &c->cexp)) >= 0) pexpand(c, &sl[k]);
-        pbarrier(c, &sense);
-        while ((k = ptake(c, &c->cmark)) >= 0) {
-            Slice *q = &sl[k];
-            q->kept = q->a < q->b;
-            for (int64_t u = 0; u < k; u++) if (sl[u].r.done < sl[u].b) q->kept = 0;
-            q->fresh = q->kept ? pmark(c, sl, k) : 0;
-        }
-        pbarrier(c, &sense);
-        if (t == 0) psettle(c, sl);
-        pbarrier(c, &sense);
-        while ((k = ptake(c, &c->cins)) >= 0) {
-            Slice *q = &sl[k];
-            if (q->kept) pinsert(c, sl, k);
-            for (int64_t d = 0; d < q->r.distinct; d++) q->ltable[q->clocal[d]] = -1;   /* empty again */
-            q->r.distinct = 0;
-            if (!q->kept) q->r.edges = 0;
-        }
+        PT(t, S_EXPAND, while ((k = ptake(c, &c->cexp)) >= 0) pexpand(c, &sl[k]));
+        PT(t, S_WAIT, pbarrier(c, &sense));
+        PT(t, S_INSERT, while ((k = ptake(c, &c->cmark)) >= 0) pput(c, sl, k));
+        PT(t, S_WAIT, pbarrier(c, &sense));
+        if (t == 0) PT(t, S_PLAN, psettle(c, sl));
     }
 }"""
 
@@ -633,6 +722,15 @@ void expand(const U *front, int64_t n, U *out, int32_t *inv, int32_t *rules, int
     for (int q = 1; q < W; q++) hh = (hh ^ (hh >> 31) ^ t[q]) * 0xBF58476D1CE4E5B9ULL; \\
     hh = (hh ^ (hh >> 29)) * 0x94D049BB133111EBULL; \\
     U slot = hh >> (64 - tbits)
+/* before the k successors in succ are probed: their hashes (hs_), each one's first slot and the
+   row its id names asked of memory at once (a probe of a table many times the cache misses
+   twice: the successors' misses overlap instead of queueing) */
+#define SUCC_SLOTS() \\
+    U hs_[NRULES]; \\
+    for (int64_t j_ = 0; j_ < k; j_++) {{ \\
+        const U *t = succ + (size_t)j_ * W; HASH_SLOT(); hs_[j_] = hh; __builtin_prefetch(&table[slot]); }} \\
+    for (int64_t j_ = 0; j_ < k; j_++) {{ \\
+        int32_t g_ = table[hs_[j_] >> (64 - tbits)]; if (g_ >= 0) __builtin_prefetch(keys + (size_t)g_ * KW); }}
 /* bfs: expand the stored states i .. stop-1 (ids in breadth-first order) into the store itself
    (storage.StateStore): its hash table (mix64, triangular probing: the same slots as numpy's),
    byte rows, parents, edges and degrees. Stops before a state whose successors might not fit
@@ -655,9 +753,10 @@ void bfs(int64_t i, int64_t stop, uint8_t *keys, int64_t nk, int64_t klimit, int
         memcpy(s, keys + (size_t)i * KW, KW);      /* little-endian rows (Builder) */
         int64_t k = visit(s, succ, sr, r);
         if (k < 0) break;
+        SUCC_SLOTS();
         for (int64_t j = 0; j < k; j++) {{
             const U *t = succ + (size_t)j * W;
-            HASH_SLOT();
+            U hh = hs_[j], slot = hh >> (64 - tbits);
             memcpy(tb, t, KW);
             int32_t got;
             for (U step = 1;; step++) {{
@@ -677,16 +776,37 @@ void bfs(int64_t i, int64_t stop, uint8_t *keys, int64_t nk, int64_t klimit, int
     }}
     r->done = i; r->edges = ne; r->distinct = nk; r->layers = nl;
 }}
-/* the hash table of the stored rows 0 .. n-1 (distinct), as bfs probes it */
+/* the first slot of stored row i (HASH_SLOT) */
+static inline U rowslot(const uint8_t *keys, int64_t i, int64_t tbits) {{
+    U t[W];
+    memset(t, 0, sizeof t);
+    memcpy(t, keys + (size_t)i * KW, KW);
+    HASH_SLOT();
+    return slot;
+}}
+/* the slots of rows lo .. hi-1, each asked of memory PF rows before it is probed (a rehash is
+   random writes into a table many times the cache: the misses overlap instead of queueing);
+   `place(slot, id)` puts one row */
+#define PF 16
+#define REHASH_LOOP(PLACE) do {{ \
+    U ring_[PF]; \
+    for (int64_t j_ = lo; j_ < hi && j_ < lo + PF; j_++) {{ \
+        ring_[(j_ - lo) % PF] = rowslot(keys, j_, tbits); __builtin_prefetch(&table[ring_[(j_ - lo) % PF]], 1); }} \
+    for (int64_t i_ = lo; i_ < hi; i_++) {{ \
+        U at_ = ring_[(i_ - lo) % PF]; \
+        if (i_ + PF < hi) {{ \
+            U nx_ = rowslot(keys, i_ + PF, tbits); ring_[(i_ - lo) % PF] = nx_; __builtin_prefetch(&table[nx_], 1); }} \
+        PLACE(at_, (int32_t)i_); \
+    }} }} while (0)
+#define RPLACE(SLOT, ID) do {{ U sl_ = (SLOT); \
+    for (U step = 1; table[sl_] >= 0; step++) sl_ = (sl_ + step) & tmask; \
+    table[sl_] = (ID); }} while (0)
+/* the hash table (its slots not yet set) of the stored rows 0 .. n-1 (distinct), as bfs probes it */
 void rehash(const uint8_t *keys, int64_t n, int64_t width, int32_t *table, int64_t tbits) {{
-    U tmask = ((U)1 << tbits) - 1, t[W];
-    for (int64_t i = 0; i < n; i++) {{
-        memset(t, 0, sizeof t);
-        memcpy(t, keys + (size_t)i * KW, KW);
-        HASH_SLOT();
-        for (U step = 1; table[slot] >= 0; step++) slot = (slot + step) & tmask;
-        table[slot] = (int32_t)i;
-    }}
+    U tmask = ((U)1 << tbits) - 1;
+    int64_t lo = 0, hi = n;
+    memset(table, 0xff, ((size_t)1 << tbits) * sizeof *table);      /* every slot -1: empty */
+    REHASH_LOOP(RPLACE);
 }}""")
         out.append(_PARALLEL.replace("RULE_T", rule_t).replace("HIT_FULL", str(HIT_FULL)))
         return out
@@ -816,7 +936,7 @@ class Native:
         return Stop(int(r.done), int(r.kind), int(r.index), message, self.layers[:r.layers].tolist())
 
     def rehash(self, keys: np.ndarray, table: np.ndarray, bits: int) -> None:
-        """Fill the empty `table` (int32, 2^bits slots) with the ids of the stored byte rows."""
+        """Fill `table` (int32, 2^bits slots, not yet set: np.empty) with the ids of the stored byte rows."""
         p, n64 = ctypes.c_void_p, ctypes.c_int64
         self.lib.rehash.restype = None
         self.lib.rehash(p(keys.ctypes.data), n64(len(keys)), n64(keys.shape[1]), p(table.ctypes.data), n64(bits))
@@ -877,7 +997,7 @@ class Builder:
             if os.environ.get("ARACHNAE_NATIVE", "1") != "0" and sys.byteorder == "little":
                 try:
                     self.src = c_source(self.model, self.shift, self.width, self.total_bits)
-                    digest = hashlib.sha256((self.src + " ".join(CC_FLAGS)).encode()).hexdigest()[:24]
+                    digest = hashlib.sha256((self.src + " ".join(cc_flags())).encode()).hexdigest()[:24]
                     self._lib = _cache_dir() / f"succ_{digest}.so"
                 except Unsupported:
                     pass
@@ -905,7 +1025,7 @@ class Builder:
                 with tempfile.TemporaryDirectory(dir=lib.parent) as tmp:
                     c_file, so = Path(tmp) / "succ.c", Path(tmp) / "succ.so"
                     c_file.write_text(self.src)
-                    subprocess.run([cc, *CC_FLAGS, "-o", str(so), str(c_file)], check=True,
+                    subprocess.run([cc, *cc_flags(), "-o", str(so), str(c_file)], check=True,
                                    capture_output=True, timeout=300)
                     os.replace(so, lib)             # atomic: a concurrent run sees all of it or nothing
             except (OSError, subprocess.SubprocessError):

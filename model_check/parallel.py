@@ -7,18 +7,21 @@ writes the same store as the one-thread `bfs` (model_check.native), so responses
 final checks and counterexamples run on it unchanged. The search goes in rounds, all
 in C (native.py `prun`, called on every thread; the threads meet at barriers in C):
 
-1. thread 0 cuts the next stored states (they may run on into the next layer) into
-   consecutive slices, SLICES per thread; in each step below the threads take the slices as
-   they come free, so a thread held up by other load holds the round up less;
+1. thread 0 settles the last round and cuts the next stored states (they may run on into the
+   next layer) into consecutive slices, SLICES per thread; in each step below the threads take
+   the slices as they come free, so a thread held up by other load holds the round up less;
 2. each slice is expanded against the table as it is (read only): an edge to a
    stored state gets its id; a successor not stored becomes a candidate of the slice,
    deduplicated in the slice's own table;
-3. a candidate an earlier slice has too is that slice's; the others are new, numbered in
-   first-seen order;
-4. each slice's new states get ids after the stored states and the new ones of the slices
-   before it, so ids, parents (the source of a state's first edge) and edges are those of
-   the one-thread search; rows, parents, table slots (compare-and-swap) and edges are
-   written by all threads at once.
+3. each slice in turn (one step: a slice waits for the one before it to have its base): a
+   candidate an earlier slice has too is that slice's; the others are new, numbered in
+   first-seen order, and get ids after the stored states and the new ones of the slices
+   before, so ids, parents (the source of a state's first edge) and edges are those of the
+   one-thread search; rows, parents, table slots (compare-and-swap) and edges are written by
+   all threads at once.
+
+The threads meet at three barriers a round (a short spin, then a futex sleep: a thread waiting
+for one that other load holds up gives its core away).
 
 A slice that fills its buffers (or holds a hit) ends the round there: the slices after it
 are expanded again in the next round. Only the hash table's slot order may differ from the
@@ -60,7 +63,7 @@ class Rounds:
 class _CSlice(ctypes.Structure):
     _fields_ = ([(f, ctypes.c_void_p) for f in ("ev", "er", "crow", "cpar", "chash", "cslot", "cstep", "clocal",
                                                   "ltable", "cown", "cidx")]
-                + [(f, ctypes.c_int64) for f in ("lbits", "a", "b", "edge0", "fresh", "base", "kept")]
+                + [(f, ctypes.c_int64) for f in ("lbits", "a", "b", "edge0", "fresh", "base", "kept", "ready")]
                 + [("r", _Res)])
 
 
@@ -69,7 +72,7 @@ class _Ctx(ctypes.Structure):
                 + [(f, ctypes.c_int64) for f in ("width", "tbits", "tlimit", "kcap", "ecap", "dcap", "nk", "ne", "i",
                                                   "workers", "edges_max", "narrow", "fan", "seen_states",
                                                   "seen_edges", "rounds", "status", "cap", "bcount", "bsense", "nrounds",
-                                                  "nsplit", "ndropped", "nslices", "cexp", "cmark", "cins")]
+                                                  "nsplit", "ndropped", "nslices", "cexp", "cmark", "bsleep")]
                 + [("hit", _Res)])
 
 
@@ -114,12 +117,8 @@ def search(model: Model, store: StateStore, lo: int, nat: Native, workers: int,
         store.rehash = lambda keys, table, bits: _rehash(nat, pool, workers, keys, table, bits)
         while True:
             _bind(ctx, store)
-            ctx.status, ctx.rounds, ctx.bcount, ctx.bsense = P_RUN, ROUNDS, 0, 0
-            ctx.cexp = ctx.cmark = ctx.cins = 0
-            futures = [pool.submit(prun, ctypes.byref(ctx), csl, ctypes.c_int64(t)) for t in range(1, workers)]
-            prun(ctypes.byref(ctx), csl, ctypes.c_int64(0))
-            for f in futures:
-                f.result()
+            ctx.status, ctx.rounds, ctx.bcount, ctx.bsense, ctx.bsleep = P_RUN, ROUNDS, 0, 0, 0
+            _on_threads(pool, prun, [(ctypes.byref(ctx), csl, ctypes.c_int64(t)) for t in range(workers)])
             rounds.rounds, rounds.split, rounds.dropped = ctx.nrounds, ctx.nsplit, ctx.ndropped
             store.keys.n = store.parent.n = ctx.nk
             store.dst.n = store.rule.n = ctx.ne
@@ -141,14 +140,21 @@ def search(model: Model, store: StateStore, lo: int, nat: Native, workers: int,
 
 def _rehash(nat: Native, pool: ThreadPoolExecutor, workers: int, keys: np.ndarray, table: np.ndarray,
             bits: int) -> None:
-    """`Native.rehash` on all the threads (a part of the rows each; the serial rehash was
-    6.6% of a two-thread profile): the empty `table` gets the ids of the stored rows."""
-    fn = nat.lib.prehash
-    fn.restype = None
+    """`Native.rehash` on all the threads (the serial rehash was 6.6% of a two-thread profile):
+    each empties a part of the slots of `table` (not yet set: np.empty, so its pages are first
+    touched here, on the threads), then, once all are empty, puts a part of the stored rows."""
     p, n64 = ctypes.c_void_p, ctypes.c_int64
+    slots = [len(table) * t // workers for t in range(workers + 1)]
+    _on_threads(pool, nat.lib.pfill, [(p(table.ctypes.data), n64(slots[t]), n64(slots[t + 1]))
+                                      for t in range(workers)])
     cuts = [len(keys) * t // workers for t in range(workers + 1)]
-    args = [(p(keys.ctypes.data), n64(cuts[t]), n64(cuts[t + 1]), p(table.ctypes.data), n64(bits))
-            for t in range(workers)]
+    _on_threads(pool, nat.lib.prehash, [(p(keys.ctypes.data), n64(cuts[t]), n64(cuts[t + 1]),
+                                         p(table.ctypes.data), n64(bits)) for t in range(workers)])
+
+
+def _on_threads(pool: ThreadPoolExecutor, fn, args: list[tuple]) -> None:
+    """`fn(*args[t])` on thread t of the search (0: this one), until all have returned."""
+    fn.restype = None
     futures = [pool.submit(fn, *a) for a in args[1:]]
     fn(*args[0])
     for f in futures:

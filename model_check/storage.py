@@ -29,6 +29,8 @@ import ast
 import ctypes
 import ctypes.util
 import functools
+import mmap
+import os
 from itertools import repeat
 from typing import Callable
 
@@ -101,15 +103,20 @@ def _status(key: str) -> int:
 class Grow:
     """An append-only numpy array grown in place by 1/4 at a time.
 
-    `ndarray.resize` reallocates, which for a large (mmap-backed) block is an mremap: no
-    copy, so the old and the new array are never both resident (a copying doubling put
-    one whole extra array on top of the peak). It zero-fills the new capacity, which is
-    therefore resident at once; growing by a quarter bounds that slack to 25 %.
-    A view taken before an `append` or `trim` is invalid after it (the block may have moved)."""
+    From `_MAPPED` bytes its memory is a mapping of its own (`_Pages`) grown by mremap: no
+    copy, so the old and the new array are never both resident (a copying doubling put one
+    whole extra array on top of the peak), and no zero-fill: the new capacity becomes resident
+    only as it is written, page by page, on the thread that writes it. Below that it is a
+    numpy block on the C heap, which reuses memory already resident (a mapping per small
+    array doubled the 1,816-state arbitration model's bytes/state, 54 -> 110). Either way
+    unwritten rows read 0. A view taken before an `append`, `reserve` or `trim` is invalid
+    after it (the block may have moved)."""
 
     def __init__(self, dtype, width: int = 0, capacity: int = 1024):
         self.width = width
-        self.data = np.empty((capacity, width) if width else capacity, dtype)
+        self.dtype = np.dtype(dtype)
+        self._pages: _Pages | None = None
+        self.data = np.zeros((capacity, width) if width else capacity, self.dtype)
         self.n = 0
 
     def append(self, chunk: np.ndarray) -> None:
@@ -122,17 +129,102 @@ class Grow:
         """Capacity for `extra` more rows (grown by a quarter at least, as `append` does)."""
         need = self.n + extra
         if need > len(self.data):
-            cap = max(need, len(self.data) + len(self.data) // 4)
-            self.data.resize((cap, self.width) if self.width else cap, refcheck=False)
-            _trim()       # a small block moves on the C heap: give back the one it left
+            self._resize(max(need, len(self.data) + len(self.data) // 4))
 
     def trim(self) -> None:
         """Capacity down to the length (no more appends are expected; they would still work)."""
-        self.data.resize((max(self.n, 1), self.width) if self.width else max(self.n, 1), refcheck=False)
+        self._resize(max(self.n, 1))
+
+    def _resize(self, cap: int) -> None:
+        shape = (cap, self.width) if self.width else (cap,)
+        if self._pages is None and self._bytes(cap) < _MAPPED:
+            self.data.resize(shape, refcheck=False)      # small: numpy's heap block, zero-filled
+            _trim()       # a small block moves on the C heap: give back the one it left
+            return
+        if self._pages is None:                           # crossing into a mapping: one copy
+            small, self._pages = self.data, _Pages(self._bytes(cap))
+            self.data = self._pages.array(shape, self.dtype)
+            self.data[:self.n] = small[:self.n]
+            return
+        self._pages.resize(self._bytes(cap))
+        self.data = self._pages.array(shape, self.dtype)
+
+    def _bytes(self, rows: int) -> int:
+        return rows * max(self.width, 1) * self.dtype.itemsize
 
     @property
     def view(self) -> np.ndarray:
         return self.data[:self.n]
+
+
+class _Pages:
+    """Anonymous memory (mmap) that grows by mremap: no copy (page tables move) and no zero-fill
+    here: a page comes zeroed from the kernel when first touched, on the thread that touches it
+    (numpy's `resize` memsets the new capacity on the calling thread: the serial pause between
+    rounds of the parallel search, model_check.parallel). Freed when no array views it."""
+
+    def __init__(self, nbytes: int):
+        self.nbytes = _pages(nbytes)
+        addr = _mm().mmap(None, self.nbytes, _PROT_RW, _MAP_ANON, -1, 0)
+        self.addr = _mapped(addr, self.nbytes)
+        self._huge()
+
+    def resize(self, nbytes: int) -> None:
+        nbytes = _pages(nbytes)
+        if nbytes != self.nbytes:
+            self.addr = _mapped(_mm().mremap(self.addr, self.nbytes, nbytes, _MREMAP_MAYMOVE), nbytes)
+            self.nbytes = nbytes
+            self._huge()
+
+    def _huge(self) -> None:
+        """Transparent huge pages for a large block, as numpy asks for its own (the search probes
+        rows at random: without them 1-thread id_retry ran 8% slower); only a hint."""
+        if self.nbytes >= _HUGE:
+            _mm().madvise(self.addr, self.nbytes, _MADV_HUGEPAGE)
+
+    def array(self, shape: tuple[int, ...], dtype: np.dtype) -> np.ndarray:
+        """The memory as an array (its base keeps this mapping alive)."""
+        return np.asarray(_Window(self, shape, dtype))
+
+    def __del__(self) -> None:
+        _mm().munmap(self.addr, self.nbytes)
+
+
+class _Window:
+    """The array interface of a `_Pages` at its present address."""
+
+    def __init__(self, pages: _Pages, shape: tuple[int, ...], dtype: np.dtype):
+        self.pages = pages
+        self.__array_interface__ = {"data": (pages.addr, False), "shape": shape, "typestr": dtype.str,
+                                    "version": 3}
+
+
+_PROT_RW, _MAP_ANON, _MREMAP_MAYMOVE = 0x1 | 0x2, 0x02 | 0x20, 1   # PROT_READ|WRITE, MAP_PRIVATE|ANONYMOUS
+_MADV_HUGEPAGE, _HUGE = 14, 1 << 22                                  # numpy's threshold for the hint: 4 MiB
+_MAPPED = 1 << 20                      # a Grow from here on is a mapping (glibc maps blocks from 128 kB-32 MB)
+
+
+def _pages(nbytes: int) -> int:
+    size = mmap.PAGESIZE
+    return max(size, -(-nbytes // size) * size)
+
+
+def _mapped(addr: int | None, nbytes: int) -> int:
+    if addr is None or addr == ctypes.c_void_p(-1).value:                 # MAP_FAILED
+        raise MemoryError(f"cannot map {nbytes} bytes: {os.strerror(ctypes.get_errno())}")
+    return addr
+
+
+@functools.cache
+def _mm() -> ctypes.CDLL:
+    """The C library's mmap, mremap, munmap and madvise, typed (Linux: the compiled search runs there)."""
+    lib = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+    vp, sz, i = ctypes.c_void_p, ctypes.c_size_t, ctypes.c_int
+    for name, args, res in (("mmap", [vp, sz, i, i, i, ctypes.c_long], vp), ("mremap", [vp, sz, sz, i], vp),
+                            ("munmap", [vp, sz], i), ("madvise", [vp, sz, i], i)):
+        fn = getattr(lib, name)
+        fn.argtypes, fn.restype = args, res
+    return lib
 
 
 def mix64(rows: np.ndarray, seed: np.uint64 = np.uint64(0)) -> np.ndarray:
@@ -252,11 +344,12 @@ class StateStore:
             size *= 2
         self.table = None                             # the old table goes before the new one comes
         _trim()
-        self.table = np.full(size, -1, np.int32)
         keys = self.keys.view
-        if self.rehash is not None:                   # the compiled search's: no temporaries at all
+        if self.rehash is not None:                   # the compiled search's: no temporaries at all, and it
+            self.table = np.empty(size, np.int32)     # empties the slots itself (on the search's threads)
             self.rehash(keys, self.table, self.table_bits)
             return
+        self.table = np.full(size, -1, np.int32)
         for lo in range(0, len(self), REHASH):        # in slices: the hash temporaries stay small
             rows = self._unpack(keys[lo:lo + REHASH])
             self._claim(self._hash(rows).astype(np.int64), np.arange(lo, lo + len(rows), dtype=np.int32),
@@ -385,7 +478,7 @@ class StateStore:
 
     def finish(self, keep_table: bool = False) -> None:
         """The search is over: drop the hash table (unless asked) and the degrees for CSR offsets,
-        and give back the zero-filled tail of every array (a shrinking realloc: no copy)."""
+        and give back the unused tail of every array (a shrinking mremap: no copy)."""
         if not keep_table:
             self.table = None
         for g in (self.keys, self.parent, self.dst, self.rule):

@@ -78,7 +78,7 @@ def test_native_search_equals_reference(spec, build, after, monkeypatch):
 
         def reserve(self, extra):
             if self.n + extra > len(self.data):
-                self.data.resize((self.n + extra, self.width) if self.width else self.n + extra, refcheck=False)
+                self._resize(self.n + extra)
     monkeypatch.setattr(storage, "Grow", Tight)
     init = native.Native.__init__
 

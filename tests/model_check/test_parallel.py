@@ -5,10 +5,10 @@ import json
 import numpy as np
 import pytest
 
-from model_check import parallel
+from model_check import native, parallel
 from model_check import spec_adapter as sa
 from model_check.checks import build_models
-from model_check.compile import RangeError
+from model_check.compile import RangeError, compile_model
 from model_check.engine import explore
 from model_check.gcl import Invariant, Rule
 from tests.model_check import toys
@@ -106,3 +106,41 @@ def test_cli_runs_the_parallel_search(capsys):
     assert one["holds"] and one["responses"] and {k: one[k] for k in keep} == {k: two[k] for k in keep}
     assert main(["check", "id_retry", "--workers", "2", "--bitstate", "20"]) == 1
     assert "choose one" in capsys.readouterr().err
+
+
+def test_extra_compiler_flags_build_their_own_library(monkeypatch, rounds):
+    """ARACHNAE_NATIVE_CFLAGS (here the phase timers, -DPSTAT) is part of the cache key, and the
+    timed build still compiles and runs the threaded search to the same store: a build that
+    fails to compile would leave the search on the Python path without a word."""
+    model = toys.tokens(4, 3)
+    plain = compile_model(model).native.lib()
+    monkeypatch.setenv(native.EXTRA_FLAGS_ENV, "-DPSTAT")
+    comp = compile_model(model)
+    assert comp.native.lib() != plain
+    seq = explore(model, progress=False, use_native=True)
+    par = explore(model, comp, progress=False, use_native=True, workers=2)
+    assert par.native is not None and par.rounds.rounds > 0
+    assert all(np.array_equal(a, b) for a, b in zip(_store(par), _store(seq)))
+
+
+def test_a_grown_table_is_emptied_by_its_rehash(monkeypatch, rounds):
+    """The compiled search's grown table comes unset (np.empty): its rehash empties every slot
+    itself (on all the threads in the threaded search). Filled with a stored id first (what a
+    slot it missed would hold), the table still gives the one store."""
+    model = toys.torus(3, 20)                                  # 8,000 states: the table grows twice
+    ref = explore(model, progress=False, use_native=True)
+    calls = []
+
+    def dirty(fn):
+        def rehash(*a):
+            table = a[-2]
+            table[:] = 0
+            calls.append(len(table))
+            fn(*a)
+        return rehash
+    monkeypatch.setattr(native.Native, "rehash", dirty(native.Native.rehash))
+    monkeypatch.setattr(parallel, "_rehash", dirty(parallel._rehash))
+    for workers in (1, 2):
+        got = explore(model, progress=False, use_native=True, workers=workers)
+        assert got.states == ref.states and all(np.array_equal(a, b) for a, b in zip(_store(got), _store(ref)))
+    assert len(calls) >= 2 and max(calls) >= 1 << 14, calls

@@ -10,7 +10,7 @@ from model_check import spec_adapter as sa
 from model_check.compile import compile_model
 from model_check.engine import explore
 from model_check.models import id_retry
-from model_check.storage import COUNT, Meter, StateStore
+from model_check.storage import COUNT, Grow, Meter, StateStore
 
 
 @pytest.mark.parametrize("bits", [20, 64, 129, 200])
@@ -116,3 +116,21 @@ def test_slicing_wide_layers_changes_nothing(monkeypatch):
         assert (sliced.violation is None) == (whole.violation is None)
         if whole.violation:
             assert [s.state for s in sliced.violation.trace] == [s.state for s in whole.violation.trace]
+
+
+def test_grown_arrays_keep_their_rows_and_read_zero_beyond():
+    """Grow starts as a heap block and crosses into its own mapping (mremap, no zero-fill by
+    numpy) from 1 MiB: the rows written stay through growth, the crossing and trim, capacity never written reads 0 (the kernel's pages, not garbage),
+    and a view taken before the Grow is dropped still holds its memory."""
+    g = Grow(np.uint8, 3, 2)
+    rows = np.arange(3 * 5000, dtype=np.uint32).astype(np.uint8).reshape(-1, 3)
+    for lo in range(0, len(rows), 700):
+        g.append(rows[lo:lo + 700])
+    g.reserve(1 << 21)                                          # 6 MiB: a move and the huge-page hint
+    assert len(g.data) >= g.n + (1 << 21) and np.array_equal(g.view, rows)
+    assert not g.data[g.n:].any()
+    g.trim()
+    assert len(g.data) == g.n and np.array_equal(g.view, rows)
+    kept = g.view
+    del g
+    assert np.array_equal(kept, rows)
