@@ -32,6 +32,8 @@ from arachnae_proto.network import ADDRESS_OF, NODES
 from arachnae_proto.skeletons.np3 import Np3Skeleton
 
 from behaviours import tuning as T
+from behaviours.gait import STILL, Gait
+from behaviours.geometry import RobotGeometry
 from behaviours.np3_layers import (AVOIDANCE, REFLEXES, Tuning, body_frame, closing_in, np3_network, safe_instead,
                                    steepness_deg, uphill)
 from behaviours.runtime import Runtime
@@ -72,10 +74,14 @@ class DeadReckoning:
         v = self.speed if self.cmd == _FORWARD else -self.speed if self.cmd == _BACKWARD else 0.0
         u = self.side if self.cmd == _SIDE_L else -self.side if self.cmd == _SIDE_R else 0.0
         w = self.turn if self.cmd == _LEFT else -self.turn if self.cmd == _RIGHT else 0.0
-        a = self.th + w * dt / 2
-        self.x += (v * math.cos(a) - u * math.sin(a)) * dt
-        self.y += (v * math.sin(a) + u * math.cos(a)) * dt
-        self.th = (self.th + w * dt + math.pi) % (2 * math.pi) - math.pi
+        self.move(v * dt, u * dt, w * dt)
+
+    def move(self, fwd_m: float, left_m: float, turn_rad: float) -> None:
+        """The body moved this far in its own frame (turning about its middle while it went)."""
+        a = self.th + turn_rad / 2
+        self.x += fwd_m * math.cos(a) - left_m * math.sin(a)
+        self.y += fwd_m * math.sin(a) + left_m * math.cos(a)
+        self.th = (self.th + turn_rad + math.pi) % (2 * math.pi) - math.pi
 
     def command(self, now: float, cmd: int) -> None:
         self.advance(now)
@@ -85,6 +91,37 @@ class DeadReckoning:
     @property
     def pose(self) -> tuple[float, float, float]:
         return self.x, self.y, self.th
+
+
+class GaitReckoning(DeadReckoning):
+    """Dead reckoning through the gait's own geometry (CHOICE, no odometry): the NP3 walks a copy of the MMC's
+    gait generator (behaviours.gait, the same model, seed 3.2.3) through the MOVEs it sends and adds up how
+    far the stance feet carry the body, times the share the feet hold on the ground (`grip`).
+
+    Why: a constant turn rate (22.5 deg/s) was wrong by the phase a turn starts in: the gait re-phases after
+    a start or a turn, and a stance foot at its stroke's end holds the body until it has stepped, so a turn
+    after walking turned 8.8-23 deg/s over its first seconds (issue 17: the heading ended 16-74 deg off).
+    The model has those pauses; the sensors are not needed for it, and the simulator's pose is not read.
+    """
+
+    def __init__(self, geometry: RobotGeometry, grip: float, step_s: float) -> None:
+        super().__init__(0.0, 0.0)
+        self.gait = Gait(geometry)
+        self.grip, self.step_s = grip, step_s
+
+    def advance(self, now: float) -> None:
+        if self.t is None:
+            self.t = now
+        while self.t + self.step_s / 2 <= now:            # the MMC's control period, whole steps
+            self.t += self.step_s
+            self.gait.advance(self.step_s)
+            m = self.gait.moved
+            if m is not STILL:
+                self.move(m.fwd_m * self.grip, m.left_m * self.grip, m.turn_rad * self.grip)
+
+    def command(self, now: float, cmd: int) -> None:
+        super().command(now, cmd)
+        self.gait.set_command(cmd)                      # a gait (7..9) too: it changes the stroke's timing
 
 
 class Np3Map(TypedDict):
@@ -122,7 +159,7 @@ class NP3(Runtime, Np3Skeleton):
         self.running = False
         self.tuning = Tuning()
         self.layers = np3_network(lambda: self.now, self.cfg.task, self.tuning)
-        self.odo = DeadReckoning(T.NP3_DR_SPEED_M_S, math.radians(T.NP3_DR_TURN_DEG_S), T.NP3_DR_SIDE_M_S)
+        self.odo = GaitReckoning(g, T.NP3_DR_GRIP, T.MMC_CONTROL_S)
         self.geo = g
         self.echoes: deque[tuple[float, ...]] = deque()   # (time, x, y, body angle seen at, arc half width m)
         half = T.NP3_MAP_SIZE_M / 2
