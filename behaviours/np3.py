@@ -8,8 +8,9 @@ source's XMIT_DATA encoding, decoded with the spec's conversions). The
 actuator "move" leaves as a MOVE record through the MCP's message
 scheduling (3.2.2): XMIT_REQ, then MOVE when the MCP grants the bus.
 
-Beside the network the node keeps a dead-reckoned pose (CHOICE: from its own
-MOVE commands and the gait's measured speeds) and the topological map of
+Beside the network the node keeps a dead-reckoned pose (CHOICE: its own MOVE
+commands walked through a copy of the MMC's gait generator, GaitReckoning, so
+a turn's re-phase pauses count) and the topological map of
 seed 3.3.2, built from the USRC's echoes (channel = head angle). The tasks that
 plan on the map correct the pose's heading from it: echoes of mapped surfaces
 vote for the heading under which the map predicts them (topomap.HeadingVotes;

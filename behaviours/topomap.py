@@ -210,8 +210,8 @@ def heading_offset(grid: OccupancyGrid, x: float, y: float, bearing: float, d: f
 
 @dataclass
 class HeadingVotes:
-    """seed 3.3.2: the dead-reckoned heading drifts (the gait turns slower than commanded at the start of a
-    turn, walks a slight curve), and a map drawn with a drifting heading is drawn rotated: a wall's end is
+    """seed 3.3.2: the dead-reckoned heading drifts (the feet slip, a reflex or a bump turns the body; the
+    gait's own pauses are in the dead reckoning, np3.GaitReckoning), and a map drawn with a drifting heading is drawn rotated: a wall's end is
     not where the map has it (light_behind_wall seeds 9, 10, issue 17). So echoes of mapped surfaces vote
     for the heading offset that makes them fit the map (heading_offset), and every `count` votes the
     heading is corrected by `gain` x their median, at most `max_step` rad at a time."""
