@@ -97,7 +97,7 @@ class DeadReckoning:
 class GaitReckoning(DeadReckoning):
     """Dead reckoning through the gait's own geometry (CHOICE, no odometry): the NP3 walks a copy of the MMC's
     gait generator (behaviours.gait, the same model, seed 3.2.3) through the MOVEs it sends and adds up how
-    far the stance feet carry the body, times the share the feet hold on the ground (`grip`).
+    far the stance feet carry the body, times the share the feet hold on the ground (`grip`, `turn_grip`).
 
     Why: a constant turn rate (22.5 deg/s) was wrong by the phase a turn starts in: the gait re-phases after
     a start or a turn, and a stance foot at its stroke's end holds the body until it has stepped, so a turn
@@ -105,10 +105,10 @@ class GaitReckoning(DeadReckoning):
     The model has those pauses; the sensors are not needed for it, and the simulator's pose is not read.
     """
 
-    def __init__(self, geometry: RobotGeometry, grip: float, step_s: float) -> None:
+    def __init__(self, geometry: RobotGeometry, grip: float, turn_grip: float, step_s: float) -> None:
         super().__init__(0.0, 0.0)
         self.gait = Gait(geometry)
-        self.grip, self.step_s = grip, step_s
+        self.grip, self.turn_grip, self.step_s = grip, turn_grip, step_s
 
     def advance(self, now: float) -> None:
         if self.t is None:
@@ -118,7 +118,7 @@ class GaitReckoning(DeadReckoning):
             self.gait.advance(self.step_s)
             m = self.gait.moved
             if m is not STILL:
-                self.move(m.fwd_m * self.grip, m.left_m * self.grip, m.turn_rad * self.grip)
+                self.move(m.fwd_m * self.grip, m.left_m * self.grip, m.turn_rad * self.turn_grip)
 
     def command(self, now: float, cmd: int) -> None:
         super().command(now, cmd)
@@ -160,7 +160,7 @@ class NP3(Runtime, Np3Skeleton):
         self.running = False
         self.tuning = Tuning()
         self.layers = np3_network(lambda: self.now, self.cfg.task, self.tuning)
-        self.odo = GaitReckoning(g, T.NP3_DR_GRIP, T.MMC_CONTROL_S)
+        self.odo = GaitReckoning(g, T.NP3_DR_GRIP, T.NP3_DR_TURN_GRIP, T.MMC_CONTROL_S)
         self.geo = g
         self.echoes: deque[tuple[float, ...]] = deque()   # (time, x, y, body angle seen at, arc half width m)
         half = T.NP3_MAP_SIZE_M / 2
