@@ -33,6 +33,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 from arachnae_proto.enums import MovCmd
 
@@ -81,6 +82,17 @@ def pattern(gait: int, legs: tuple[int, ...]) -> tuple[float, dict[int, float]]:
     return 1 - 1 / n, {leg: i / n for i, leg in enumerate(order)}
 
 
+class BodyStep(NamedTuple):
+    """How the stance feet carried the body over one gait-clock step, in the body frame at its start."""
+
+    fwd_m: float
+    left_m: float
+    turn_rad: float
+
+
+STILL = BodyStep(0.0, 0.0, 0.0)
+
+
 @dataclass
 class LegPlan:
     swing: bool = False
@@ -113,6 +125,7 @@ class Gait:
         self.gait_switches = 0
         self.pause_s = 0.0
         self.dt = T.MMC_CONTROL_S                    # the last clock step (gait seconds); the MMC steps at this period
+        self.moved = STILL                           # the body's motion over the last step (the gait's own geometry)
         self.swing_lift = p.lift                     # how high the next swings lift (raised near an obstacle)
         self.plans = {leg: LegPlan(pos=p.neutral_foot(leg)) for leg in p.legs}
         self._set_pattern(TRIPOD)
@@ -266,6 +279,7 @@ class Gait:
         """One gait-clock step: touchdowns, the re-phase once every foot is down, lift-offs, then the body motion."""
         dt *= self.scale
         self.dt = dt
+        self.moved = STILL
         # events at the start of the step, then the motion over it
         for leg in self.legs:                                  # touchdowns first
             pl = self.plans[leg]
@@ -310,6 +324,8 @@ class Gait:
             for pl in stance:
                 pl.pos = self._move(pl.pos, dc)
                 pl.c -= dc
+            vx, vy, w = MOTION[self.command]
+            self.moved = BodyStep(dc * self.stroke * vx, dc * self.stroke * vy, dc * self.p.turn_stroke_rad * w)
 
     def _fly_time(self, start: tuple[float, float], end: tuple[float, float]) -> float:
         """The least time (gait s) a swing may take from start to end: a stroke in the shortest swing's time."""

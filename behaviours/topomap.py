@@ -23,10 +23,11 @@ from __future__ import annotations
 
 import heapq
 import math
+import statistics
 from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterable, Sequence
+from typing import Iterable, NamedTuple, Sequence
 
 from arachnae_proto.messages import XmitDataUsrc
 
@@ -155,6 +156,79 @@ class OccupancyGrid:
                 self._bump(*c, self.miss)
         if hit is not None and self.inside(*hit):
             self._bump(*hit, self.hit)
+
+
+    def ray_end(self, x: float, y: float, angle: float, max_m: float) -> RayEnd:
+        """Where the ray from (x, y) first meets a cell that is not free, within `max_m`: the distance along
+        the ray to that cell's centre and whether it is occupied (an echo would come from there) or unknown
+        (the map cannot say); (max_m, False) when it runs free all the way."""
+        c, s = math.cos(angle), math.sin(angle)
+        for i, j in ray_cells(x, y, angle, max_m, self.res, self.x0, self.y0):
+            st = self.state(i, j)
+            if st != FREE:
+                cx, cy = self.centre(i, j)
+                return RayEnd((cx - x) * c + (cy - y) * s, st == OCCUPIED)
+        return RayEnd(max_m, False)
+
+
+class RayEnd(NamedTuple):
+    """OccupancyGrid.ray_end: how far a ray runs through free cells, and what stops it."""
+
+    dist_m: float
+    occupied: bool
+
+
+def heading_offset(grid: OccupancyGrid, x: float, y: float, bearing: float, d: float, cone_deg: float,
+                   rays: int, search_deg: int, tol_m: float, max_width_deg: int) -> float | None:
+    """seed 3.3.2: the heading correction (rad) under which the map predicts a sonar echo `d` m away seen at
+    `bearing` from (x, y); None when the echo cannot tell (the map does not know the ground there, or it
+    fits a band of headings wider than `max_width_deg`, as a wall seen square on does).
+
+    The echo is the nearest surface within the cone (`rays` rays across `cone_deg`, as the transducer
+    sees it), so the prediction for a heading offset is the nearest occupied cell over the same rays turned
+    by that offset, searched within +-`search_deg` in whole degrees; the offsets that predict `d` within
+    `tol_m` must form a band narrower than `max_width_deg` that does not touch the search's ends.
+    """
+    offs = [round(-cone_deg / 2 + cone_deg * k / (rays - 1)) for k in range(rays)] if rays > 1 else [0]
+    reach = d + 2 * tol_m
+    ends = {a: grid.ray_end(x, y, bearing + math.radians(a), reach)
+            for a in range(-search_deg + min(offs), search_deg + max(offs) + 1)}
+    fits: list[int] = []
+    known = 0
+    for delta in range(-search_deg, search_deg + 1):
+        near = min((ends[delta + o] for o in offs), key=lambda e: (e.dist_m, not e.occupied))
+        if not near.occupied and near.dist_m < reach:
+            continue                                   # unknown ground before the echo: no prediction
+        known += 1
+        if near.occupied and abs(near.dist_m - grid.res / 4 - d) <= tol_m:
+            fits.append(delta)
+    if not fits or known < search_deg or max(fits) - min(fits) > max_width_deg \
+            or -search_deg in fits or search_deg in fits:
+        return None
+    return math.radians(sum(fits) / len(fits))
+
+
+@dataclass
+class HeadingVotes:
+    """seed 3.3.2: the dead-reckoned heading drifts (the feet slip, a reflex or a bump turns the body; the
+    gait's own pauses are in the dead reckoning, np3.GaitReckoning), and a map drawn with a drifting heading is drawn rotated: a wall's end is
+    not where the map has it (light_behind_wall seeds 9, 10, issue 17). So echoes of mapped surfaces vote
+    for the heading offset that makes them fit the map (heading_offset), and every `count` votes the
+    heading is corrected by `gain` x their median, at most `max_step` rad at a time."""
+
+    count: int
+    gain: float
+    max_step: float
+    votes: list[float] = field(default_factory=list)
+
+    def add(self, offset: float) -> float:
+        """One echo's vote; the correction (rad) to apply now, 0.0 until `count` votes are in."""
+        self.votes.append(offset)
+        if len(self.votes) < self.count:
+            return 0.0
+        mid = statistics.median(self.votes)
+        self.votes.clear()
+        return max(-self.max_step, min(self.max_step, self.gain * mid))
 
 
 def ray_cells(x: float, y: float, angle: float, length: float, res: float, x0: float = 0.0,
@@ -553,5 +627,5 @@ def full_scan(x: float, y: float, heading_deg: float, ranges: Sequence[float | N
     return [Reading(x, y, heading_deg, k * step_deg, d) for k, d in enumerate(ranges)]
 
 
-__all__ = ["Reading", "Place", "Frontier", "FrontierTarget", "OccupancyGrid", "TopoMap", "full_scan", "line_cells", "ray_cells",
+__all__ = ["RayEnd", "heading_offset", "HeadingVotes", "Reading", "Place", "Frontier", "FrontierTarget", "OccupancyGrid", "TopoMap", "full_scan", "line_cells", "ray_cells",
            "point_in_polygon", "UNKNOWN", "FREE", "OCCUPIED", "USRC_MAX_RANGE_M", "USRC_MIN_RANGE_M"]

@@ -147,6 +147,18 @@ NP3_DR_SIDE_M_S = 0.083       # ... loses ~10 % re-phasing), sidestep speed,
 NP3_DR_TURN_DEG_S = 22.5      # ... and turn rate on the spot (nominal 25 deg/s), all measured in sim2d
 NP3_POSE_HISTORY_S = 3.0      # dead reckoning: commands kept this long, for the pose at a record's age (issue 17;
                               # the age field reaches 2.55 s)
+NP3_DR_GRIP = 0.955           # dead reckoning through the gait model (np3.GaitReckoning): the share of the stance feet's
+                              # ... motion the body makes (bare gait in sim2d: 10 s forward 0.952 of 1.0 m, 5 s sidestep
+                              # ... 0.478 of 0.5 m), and of their turn: through the LCPs' straight stance segments the
+NP3_DR_TURN_GRIP = 0.91       # ... feet slip more (light_behind_wall seeds 4, 7, the first 120 s: each turn and the
+                              # ... 0.1-0.2 s of it that comes late, 0.938-0.960 of the model at 0.955; bare gait 0.955)
+NP3_MATCH_SEARCH_DEG = 10     # heading from the map (3.3.2, the tasks that plan on it): an echo of a mapped surface
+NP3_MATCH_TOL_M = 0.08        # ... votes for the heading offset (searched this far either side) under which the map
+NP3_MATCH_WIDTH_DEG = 6       # ... predicts its range within this (2 cm sonar noise, 10 cm cells), if the offsets
+NP3_MATCH_RANGE_M = (0.5, 5.0)  # ... that fit span at most this; echoes within this range of the robot vote;
+NP3_MATCH_VOTES = 5           # ... every this many votes the heading moves by
+NP3_MATCH_GAIN = 0.7          # ... this share of their median,
+NP3_MATCH_STEP_DEG = 5.0      # ... at most this much at once
 NP3_ECHO_KEEP_S = 10.0        # local memory: sonar / IR / whisker echoes at the dead-reckoned pose kept this long
 NP3_ECHO_NEAR_M = 1.5         # ... sonar echoes nearer than this only (the map keeps the rest), each as
 NP3_SONAR_CONE_POINTS = 5     # ... this many points across the beam (the reflector is somewhere on that arc);

@@ -10,7 +10,8 @@ from arachnae_proto import messages as M
 from arachnae_proto.enums import MmcError, MovCmd, RangeStatus, RecordKind, TpscContact
 from arachnae_proto.network import ADDRESS_OF
 from behaviours import tuning as T
-from behaviours.np3 import DeadReckoning, Echo, Ping, decode
+from behaviours.geometry import DEFAULT_GEOMETRY
+from behaviours.np3 import DeadReckoning, Echo, GaitReckoning, Ping, decode
 from behaviours.np3_layers import (LSC_STEP_LOG, TaskModule, Tuning, body_frame, clear_ahead, light_gradient, np3_network,
                                    wall_beside)
 from behaviours.units import age_byte, quantizer
@@ -426,6 +427,62 @@ def test_dead_reckoning_knows_the_pose_at_an_earlier_time():
     x, y, th = odo.pose_at(2.9)                                   # half way through the turn
     assert (x, y, math.degrees(th)) == pytest.approx((0.1, 0.0, 22.5))
     assert odo.pose_at(5.0) == odo.pose and math.degrees(odo.pose[2]) == pytest.approx(45.0)
+
+
+def test_the_gait_models_dead_reckoning_knows_the_pose_at_an_earlier_time():
+    """issue 17 + s9-light: the reckoning through the gait model answers pose_at(t) with the pose it had at t,
+    also mid-turn and inside a re-phase pause (the command's own leg would hold the pose it started from)."""
+    plan = [(0.0, MovCmd.FORWARD), (2.0, MovCmd.TURN_LEFT), (3.6, MovCmd.FORWARD), (4.4, MovCmd.STOP)]
+    odo = GaitReckoning(DEFAULT_GEOMETRY, T.NP3_DR_GRIP, T.NP3_DR_TURN_GRIP, T.MMC_CONTROL_S)
+    twin = GaitReckoning(DEFAULT_GEOMETRY, T.NP3_DR_GRIP, T.NP3_DR_TURN_GRIP, T.MMC_CONTROL_S)
+    for at, cmd in plan:
+        odo.command(at, int(cmd))
+    odo.advance(5.0)
+    queue = list(plan)
+    for t in (1.505, 2.505, 3.005, 3.905, 4.605):                 # between steps; the twin walked only up to t
+        while queue and queue[0][0] <= t:
+            at, cmd = queue.pop(0)
+            twin.command(at, int(cmd))
+        twin.advance(t)
+        assert odo.pose_at(t) == pytest.approx(twin.pose, abs=1e-9)
+    assert math.degrees(odo.pose_at(3.005)[2]) > 5.0 and odo.pose_at(3.005) != odo.pose_at(2.005)
+    first, last = odo.legs[0], odo.legs[-1]
+    assert last.t - odo.legs[1].t <= T.NP3_POSE_HISTORY_S < last.t - first.t     # the history is kept, no more
+    assert odo.pose_at(0.0) == (first.x, first.y, first.th)                        # before it: its start
+
+
+def test_a_heading_correction_turns_the_pose_history_echoes_and_pings_with_the_pose(spec):
+    """3.3.2 + issue 17: the map turns the heading by 10 deg while the robot turns on the spot; a ping's pose
+    from before, the echo records and the pings' free space turn with it about the robot, so that an echo
+    placed from the corrected pose of its ping lies where the turned memory has it."""
+    rig = np3(spec, task="idle")
+    rig.run(1.0)
+    node = rig.node
+    odo = DeadReckoning(0.1, math.radians(22.5))
+    odo.command(0.0, int(MovCmd.FORWARD))
+    odo.command(0.5, int(MovCmd.TURN_LEFT))                       # at (0.05, 0): turns 22.5 deg/s from here
+    node.odo = odo
+    rig.run(2.0)
+    assert odo.cmd == int(MovCmd.TURN_LEFT)                       # the idle task sent nothing meanwhile
+    ping = node.pose_at(0.3)
+    echo = Echo(0.3, 0.5, 0.4, -20.0, 0.05, sonar=True)
+    node.echoes.append(echo)
+    node.pings.append(Ping(0.3, 0.03, 0.0, 0.3, 1.0))
+    here = node.pose_at(None)
+    turn = math.radians(10)
+    node.correct_heading(turn)
+
+    def turned(px, py):
+        dx, dy = px - here[0], py - here[1]
+        return (here[0] + dx * math.cos(turn) - dy * math.sin(turn), here[1] + dx * math.sin(turn) + dy * math.cos(turn))
+    assert node.pose_at(None) == pytest.approx((here[0], here[1], here[2] + turn))
+    assert node.pose_at(0.3) == pytest.approx((*turned(ping[0], ping[1]), ping[2] + turn))
+    assert node.pose_at(1.0)[2] == pytest.approx(math.radians(22.5 / 2) + turn)   # the turn's leg, corrected
+    (e,), (p,) = list(node.echoes), list(node.pings)
+    assert isinstance(e, Echo) and (e.x, e.y) == pytest.approx(turned(0.5, 0.4))
+    assert (e.t, e.seen_deg, e.arc_m, e.sonar) == (0.3, -20.0, 0.05, True)    # body-relative: unchanged
+    assert isinstance(p, Ping) and (p.x, p.y, p.bearing) == pytest.approx((*turned(0.03, 0.0), 0.3 + turn))
+    assert node.heading_fixed == pytest.approx(turn)
 
 
 def test_a_sonar_echo_is_placed_at_the_heading_of_its_ping(spec):

@@ -2,11 +2,13 @@
 from __future__ import annotations
 
 import math
+import statistics
 
 import pytest
 from PIL import Image
 
-from behaviours.topomap import FREE, OCCUPIED, UNKNOWN, FrontierTarget, OccupancyGrid, Reading, TopoMap, full_scan
+from behaviours.topomap import (FREE, OCCUPIED, UNKNOWN, FrontierTarget, HeadingVotes, OccupancyGrid, Reading, TopoMap,
+                               full_scan, heading_offset)
 
 Segment = tuple[tuple[float, float], tuple[float, float]]
 
@@ -322,3 +324,44 @@ def test_occupied_near_lists_the_occupied_cells_within_the_radius():
     near = g.occupied_near(1.0, 2.0, 1.0)
     assert len(near) == 1 and abs(near[0][0] - 1.85) < 0.11 and abs(near[0][1] - 2.0) < 0.1
     assert any(abs(y - 3.55) < 0.1 for _x, y in g.occupied_near(1.0, 2.0, 1.6))
+
+
+def cone_echo(walls: list[Segment], x: float, y: float, bearing: float, cone_deg: float = 15.0) -> float | None:
+    """The sonar's echo: the nearest wall over 5 rays across its cone (as sim2d's transducer sees it)."""
+    hits = [cast(walls, x, y, bearing + math.radians(-cone_deg / 2 + cone_deg * k / 4)) for k in range(5)]
+    return min((h for h in hits if h is not None), default=None)
+
+
+def votes_for(m: TopoMap, x: float, y: float, true_deg: float, believed_deg: float) -> list[float]:
+    """heading_offset's votes (deg) for echoes of ROOM every 10 deg round a robot that believes `believed_deg`."""
+    out = []
+    for head in range(0, 360, 10):
+        d = cone_echo(ROOM, x, y, math.radians(true_deg + head))
+        off = heading_offset(m.grid, x, y, math.radians(believed_deg + head), d, 15.0, 5, 10, 0.08, 6)
+        if off is not None:
+            out.append(math.degrees(off))
+    return out
+
+
+@pytest.mark.parametrize("error_deg", [-6.0, 0.0, 4.0])
+def test_echoes_of_mapped_walls_vote_for_the_heading_that_fits_the_map(square_room, error_deg):
+    votes = votes_for(square_room, 2.0, 2.5, 30.0, 30.0 - error_deg)
+    assert len(votes) >= 8                              # the walls seen at a slant can tell
+    assert statistics.median(votes) == pytest.approx(error_deg, abs=1.5)
+
+
+def test_a_wall_seen_square_on_or_ground_the_map_does_not_know_cannot_tell(square_room):
+    g = square_room.grid
+    d = cone_echo(ROOM, 3.0, 3.0, 0.0)                  # the east wall, square on from the room's middle
+    assert heading_offset(g, 3.0, 3.0, 0.0, d, 15.0, 5, 10, 0.08, 6) is None
+    blank = new_map().grid                              # nothing mapped yet
+    assert heading_offset(blank, 2.0, 2.5, math.radians(20), 2.0, 15.0, 5, 10, 0.08, 6) is None
+
+
+def test_heading_votes_correct_by_a_share_of_their_median_at_most_a_step_at_a_time():
+    v = HeadingVotes(count=3, gain=0.5, max_step=math.radians(2.0))
+    assert v.add(math.radians(2.0)) == 0.0 and v.add(math.radians(3.0)) == 0.0
+    assert math.degrees(v.add(math.radians(-9.0))) == pytest.approx(1.0)     # median 2, half of it
+    assert v.add(math.radians(10.0)) == 0.0                                  # counted afresh
+    v.add(math.radians(10.0))
+    assert math.degrees(v.add(math.radians(10.0))) == pytest.approx(2.0)     # clipped to the step
