@@ -10,14 +10,15 @@ CHROMIUM = "/usr/bin/chromium"
 FLAGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
          "--disable-component-update", "--disable-sync"]
 
-# 9 s: POST, a walk into a high block, one whisker reaction and the control layers taking turns, in a
+# 14 s: POST, a walk into a high block (12 cm: under the sonar head at 0.14 m, so the sonar does not steer round it
+# first, as in scenarios/high_obstacle.yaml), one whisker reaction and the control layers taking turns, in a
 # room with every kind of thing the report's legend knows (pit, light, heat, slope, a low and a high obstacle).
 SCENARIO = """name: report_test
-duration: 9
+duration: 14
 arena: {size: [4, 3], boundary_walls: true}
 robot: {pose: [1.2, 1.5, 0]}
 obstacles:
-  - {polygon: [[1.75, 0.9], [1.95, 0.9], [1.95, 2.1], [1.75, 2.1]], height: 0.15}
+  - {polygon: [[1.75, 0.9], [1.95, 0.9], [1.95, 2.1], [1.75, 2.1]], height: 0.12}
   - {polygon: [[0.3, 0.3], [0.8, 0.3], [0.8, 0.5], [0.3, 0.5]], height: 0.03}
 pits:
   - {polygon: [[3.2, 0.3], [3.7, 0.3], [3.7, 0.9], [3.2, 0.9]]}

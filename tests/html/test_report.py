@@ -21,7 +21,7 @@ def test_report_in_chromium(browser, report_run, tmp_path):
     for cls, n in (("pit", 1), ("light", 1), ("slope", 1), ("heat", 1), ("obstacle", 2), ("region.forbidden", 1)):
         assert page.locator(f"#world .{cls}").count() == n, cls
     legend = page.inner_text("#legend")
-    for text in ("pit", "light", "slope", "obstacle 0.03 m (stepped over)", "obstacle 0.15 m (too high to step over)"):
+    for text in ("pit", "light", "slope", "obstacle 0.03 m (stepped over)", "obstacle 0.12 m (too high to step over)"):
         assert text in legend
     # the time slider moves the robot to the first logged pose and the cursors to t = 0
     poses = json.loads(page.inner_text("#poses"))
