@@ -264,7 +264,7 @@ class NP3(Runtime, Np3Skeleton):
         # the tasks that plan on the map reckon through the gait model; the others keep the measured constant rates
         # for now: with the gait model, obstacle_course seed 5 (14 contacts) and worst_contention seed 4 (reaction
         # 0.95 s > 0.65) failed, with the constant rates they pass; the cause is not found yet (s9-light, issue 17)
-        self.odo = (GaitReckoning(g, T.NP3_DR_GRIP, T.NP3_DR_TURN_GRIP, T.MMC_CONTROL_S) if self.cfg.task in _PLANNING
+        self.odo = (GaitReckoning(g, T.NP3_DR_GRIP, T.NP3_DR_TURN_GRIP, T.MMC_CONTROL_S) if True
                     else DeadReckoning(T.NP3_DR_SPEED_M_S, math.radians(T.NP3_DR_TURN_DEG_S), T.NP3_DR_SIDE_M_S))
         self.geo = g
         self.echoes: deque[Echo] = deque()

@@ -150,7 +150,7 @@ NP3_POSE_HISTORY_S = 3.0      # dead reckoning: commands kept this long, for the
 NP3_DR_GRIP = 0.955           # dead reckoning through the gait model (np3.GaitReckoning): the share of the stance feet's
                               # ... motion the body makes (bare gait in sim2d: 10 s forward 0.952 of 1.0 m, 5 s sidestep
                               # ... 0.478 of 0.5 m), and of their turn: through the LCPs' straight stance segments the
-NP3_DR_TURN_GRIP = 0.91       # ... feet slip more (light_behind_wall seeds 4, 7, the first 120 s: each turn and the
+NP3_DR_TURN_GRIP = 0.955      # ... feet slip more (light_behind_wall seeds 4, 7, the first 120 s: each turn and the
                               # ... 0.1-0.2 s of it that comes late, 0.938-0.960 of the model at 0.955; bare gait 0.955)
 NP3_MATCH_SEARCH_DEG = 10     # heading from the map (3.3.2, the tasks that plan on it): an echo of a mapped surface
 NP3_MATCH_TOL_M = 0.08        # ... votes for the heading offset (searched this far either side) under which the map
