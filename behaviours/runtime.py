@@ -88,6 +88,29 @@ def slaves_of(bus: str) -> list[int]:
     return sorted(a for a, node in NODES.items() if node.bus == bus)
 
 
+class _LineCheck:
+    """`check(data)` of the frame on the line, or None when the codec rejects it; the last answer is kept, as
+    every station hearing a frame is handed the same bytes object in turn (bytes never change)."""
+
+    __slots__ = ("last", "result")
+
+    def __init__(self) -> None:
+        self.last: bytes | None = None
+        self.result: tuple | None = None
+
+    def __call__(self, data: bytes) -> tuple | None:
+        if data is not self.last:
+            try:
+                self.result = check(data)
+            except CodecError:
+                self.result = None
+            self.last = data
+        return self.result
+
+
+line_check = _LineCheck()
+
+
 class Request:
     __slots__ = ("dst", "msg", "expect", "on_reply", "on_timeout", "retries", "timeout", "serial", "sent", "priority")
 
@@ -360,10 +383,8 @@ class Runtime:
         """Every frame the UART hears on a bus, ended just now (the receiver's byte stream, own frames by
         their echo). The window's slots are idle slots (spec arbitration rule): a frame other than a
         request, e.g. the master serving one, does not use up a slot, so the window stands still."""
-        try:
-            _dst, src, opcode, _payload = check(data)
-        except CodecError:
-            src = opcode = None
+        checked = line_check(data)
+        src, opcode = (checked[1], checked[2]) if checked is not None else (None, None)
         if bus != self.master_bus:                   # a reply may follow the master's frame
             self._after_master[bus] = src is None or src == ADDRESS_OF[BUSES[bus].master]
         if not self._scope_all(bus):

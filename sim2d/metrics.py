@@ -12,7 +12,7 @@ from behaviours import ROLES
 from sim2d.gait_metrics import motion_schema
 from sim2d.nav_metrics import nav_schema
 
-from tracecheck.trace import COLUMNS, parse_lines, trace_lines
+from tracecheck.trace import COLUMNS, parse_lines
 from tracecheck.validate import validate
 
 if TYPE_CHECKING:
@@ -315,7 +315,7 @@ def build_metrics(sim: "Simulation") -> dict[str, Any]:
 
 def protocol_metrics(sim: "Simulation") -> dict[str, Any]:
     """The run's bus trace held to the verified protocol (tracecheck): violations (0 expected), waits, K."""
-    lines = ["\t".join(COLUMNS)] + trace_lines(sim.frames, sim.notes)
+    lines = ["\t".join(COLUMNS)] + sim.trace_rows()
     trace = parse_lines(lines, f"{sim.scenario.name}/trace.tsv", set(sim.spec.buses))
     return validate(trace, sim.spec, dict(sim.scenario.arbitration)).metrics()
 

@@ -7,6 +7,7 @@ current folder, a parent of it, the home folder or a file that is not a folder (
 """
 from __future__ import annotations
 
+import functools
 import json
 import os
 import shutil
@@ -40,7 +41,10 @@ class Outcome:
         return [e for e in self.expectations if not e[1]]
 
 
+@functools.cache
 def load_spec_once() -> Any:
+    """The spec, loaded once per process (1-2 s of YAML parsing and lint): every run of a batch or sweep
+    worker (forked from a parent that loaded it already) shares it. Runs only read it."""
     from codegen.load import load_spec
     return load_spec()
 
@@ -119,7 +123,7 @@ def write_outputs(outcome: Outcome, out_dir: str | Path, gif: bool = False, forc
         raise UserError(f"--out {out}: cannot create the output folder ({exc.strerror})") from None
     try:
         r = outcome.result
-        lines = trace_lines(r.frames, r.notes)
+        lines = r.trace_rows if r.trace_rows is not None else trace_lines(r.frames, r.notes)
         with open(tmp / "trace.tsv", "w") as fh:
             fh.write("\t".join(COLUMNS) + "\n")
             fh.write("\n".join(lines) + ("\n" if lines else ""))

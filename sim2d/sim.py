@@ -15,8 +15,6 @@ import math
 from dataclasses import dataclass, field, replace
 from typing import Any, Callable
 
-from arachnae_proto import CodecError
-from arachnae_proto.frame import check
 from arachnae_proto.messages import BY_NAME as MESSAGES
 from arachnae_proto.network import BROADCAST
 
@@ -24,7 +22,7 @@ from behaviours import behaviour_class
 from captures.pcapng import CapturedFrame
 from behaviours.netconfig import Config, NetConfig
 from behaviours.post import Verdict
-from behaviours.runtime import Runtime
+from behaviours.runtime import Runtime, line_check
 from sim2d.bus import Bus, Fault as BusFault, TraceEntry
 from sim2d.events import Scheduler
 from sim2d.geometry import point_in_polygon
@@ -36,6 +34,7 @@ from sim2d.robot_params import DEFAULT, RobotParams
 from sim2d.scenario import Scenario
 from sim2d.sensors import Sensors
 from sim2d.world import World
+from tracecheck.trace import trace_lines
 
 POSE_SAMPLE_S = 0.1       # pose log resolution (trace hash, plot)
 CLEARANCE_SAMPLE_S = 0.05
@@ -59,33 +58,10 @@ class Result:
     frames_png: list = field(default_factory=list)
     nodes: dict = field(default_factory=dict)      # short name -> node (for its debug-port artifacts)
     notes: list = field(default_factory=list)      # debug-port notes: (t, node, event, data)
+    trace_rows: list[str] | None = None            # trace.tsv's rows (Simulation.trace_rows); None: not made
 
 
-class _Intact:
-    """Whether a frame passes the codec's size and CRC checks, computed once per frame on the wire:
-    the bus hands the same bytes object to every station in turn."""
-
-    __slots__ = ("last", "ok")
-
-    def __init__(self) -> None:
-        self.last: bytes | None = None
-        self.ok = False
-
-    def __call__(self, data: bytes) -> bool:
-        if data is not self.last:
-            self.last = data
-            try:
-                check(data)
-                self.ok = True
-            except CodecError:
-                self.ok = False
-        return self.ok
-
-
-_INTACT = _Intact()
-
-
-def _receiver(node: Runtime, hw: NodeHardware, intact: _Intact = _INTACT) -> Any:
+def _receiver(node: Runtime, hw: NodeHardware) -> Any:
     """The node's UART: every frame on the bus reaches the skeleton's receive(), which parses it.
 
     Shortcut, same outcome: a frame that is intact and addressed to another node
@@ -100,7 +76,7 @@ def _receiver(node: Runtime, hw: NodeHardware, intact: _Intact = _INTACT) -> Any
             return
         if heard is not None:
             heard(bus, data)
-        if data and data[0] != own and data[0] != BROADCAST and intact(data):
+        if data and data[0] != own and data[0] != BROADCAST and line_check(data) is not None:
             return
         receive(bus, data)              # ours, broadcast, or bad: the skeleton parses (and reports) it
     return deliver
@@ -163,6 +139,7 @@ class Simulation:
         self.entered_time: float | None = None
         self.snapshots: list[tuple[float, tuple[float, float, float], list]] = []
         self.keep_frames_every = keep_frames_every
+        self._trace_rows: list[str] | None = None
         absent = set(scenario.absent)
         for n in spec.nodes:
             if n.short in absent:
@@ -188,6 +165,13 @@ class Simulation:
     # --- trace and telemetry ------------------------------------------------------
     def _trace(self, e: TraceEntry) -> None:
         self.frames.append(e)      # decoded only when written: the bytes determine the text
+
+    def trace_rows(self) -> list[str]:
+        """trace.tsv's rows (tracecheck.trace.trace_lines) of the finished run, made once: the protocol
+        metrics read them and write_outputs writes them (decoding every frame twice took ~15 % of a run)."""
+        if self._trace_rows is None:
+            self._trace_rows = trace_lines(self.frames, self.notes)
+        return self._trace_rows
 
     def on_note(self, node: Any, event: str, data: dict[str, Any]) -> None:
         """A node's debug-port telemetry (behaviours.hardware.Hardware.note) into the metrics."""
@@ -327,7 +311,7 @@ class Simulation:
         from sim2d.metrics import build_metrics
         metrics = build_metrics(self)
         return Result(self.scenario, self.verdict, self.frames, self.poses, metrics, metrics["trace_hash"],
-                      self.sensors, self.world, self.robot, self.snapshots, self.nodes, self.notes)
+                      self.sensors, self.world, self.robot, self.snapshots, self.nodes, self.notes, self.trace_rows())
 
 
 def capture_frames(frames: list[TraceEntry]) -> list[CapturedFrame]:

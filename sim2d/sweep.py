@@ -325,7 +325,6 @@ def finished_rows(out: Path, plan_: Plan) -> dict[str, dict[str, Any]]:
 
 
 # -- one run: a Dask task --------------------------------------------------------------------------
-_SPEC: list[Any] = []      # the spec, loaded once per worker process
 
 
 def _value(v: Any) -> Any:
@@ -338,10 +337,8 @@ def run_task(run_id: str, scenario_file: str, metrics: list[str], failed_dir: st
     the usual outputs to `failed_dir`."""
     from sim2d import runner
 
-    if not _SPEC:
-        _SPEC.append(runner.load_spec_once())
     try:
-        outcome = runner.run(scenario_file, None, _SPEC[0])
+        outcome = runner.run(scenario_file, None, runner.load_spec_once())
     except UserError as exc:
         return {"run_id": run_id, "passed": False, "failed": "error", "error": str(exc), "trace_hash": None,
                 "metrics": {m: None for m in metrics}, "expect": {}}

@@ -11,6 +11,7 @@ left the line at the bus's baud rate, and it has no debug-port rows.
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterable
@@ -92,9 +93,15 @@ def frame_row(start: float, end: float, bus: str, sender: str, sent: bytes, hear
               flags: tuple[str, ...]) -> str:
     """A frame as a trace row; the message column is the generated codec's reading of the bytes heard."""
     data = heard if heard is not None else sent
+    return f"{start:.6f}\t{end:.6f}\t{bus}\t{sender}\t{_reading(data)}\t{','.join(flags)}\t{sent.hex()}"
+
+
+@functools.lru_cache(maxsize=1 << 16)
+def _reading(data: bytes) -> str:
+    """The src, dst, message and bytes columns of a frame: the same bytes always read the same, and a run
+    repeats most of its frames (polls, set-points: ~2,500 distinct among ~19,000 in the default run)."""
     d = decode(data)
-    return (f"{start:.6f}\t{end:.6f}\t{bus}\t{sender}\t{d.src}\t{d.dst}\t{d.text}\t{data.hex()}\t{','.join(flags)}"
-            f"\t{sent.hex()}")
+    return f"{d.src}\t{d.dst}\t{d.text}\t{data.hex()}"
 
 
 def trace_lines(frames: Iterable[Any], notes: Iterable[tuple[float, str, str, dict[str, Any]]] = ()) -> list[str]:
