@@ -16,6 +16,8 @@ write, several sections).
 """
 from __future__ import annotations
 
+import functools
+
 import struct
 from pathlib import Path
 from typing import IO, Iterable, NamedTuple
@@ -67,6 +69,7 @@ def bus_interfaces(spec) -> tuple[Interface, ...]:
     return tuple(Interface(b.name, spec.frame.pcap_linktype, b.long, b.baud) for b in spec.buses.values())
 
 
+@functools.lru_cache(maxsize=1 << 16)     # a run's capture repeats most of its frames (polls, set-points)
 def link_errors(data: bytes) -> int:
     """The epb_flags error bits a receiver finds in the bytes themselves (size and CRC, like the codec)."""
     from arachnae_proto import CodecError, ErrorKind

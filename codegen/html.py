@@ -8,6 +8,8 @@ sim2d.report renders the run report with the same environment and base page.
 """
 from __future__ import annotations
 
+import functools
+
 from collections import defaultdict
 from dataclasses import dataclass
 from fractions import Fraction
@@ -24,8 +26,10 @@ from codegen.model import Message, Node, Spec
 HTML_TEMPLATES = Path(__file__).resolve().parent / "templates" / "html"
 
 
+@functools.cache
 def environment(*extra_dirs: Path) -> jinja2.Environment:
-    """Jinja2 with autoescape on, over `extra_dirs` first and then the shared HTML templates."""
+    """Jinja2 with autoescape on, over `extra_dirs` first and then the shared HTML templates. One per process:
+    its templates are compiled once (a batch writes a report.html per run; jinja2 reloads a template changed on disk)."""
     env = jinja2.Environment(loader=jinja2.FileSystemLoader([*map(str, extra_dirs), str(HTML_TEMPLATES)]),
                              autoescape=True, undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True)
     env.filters.update(number=number, hex2=lambda v: f"0x{v:02X}")

@@ -5,7 +5,8 @@ deterministic for a given seed.
 """
 from __future__ import annotations
 
-import heapq
+import itertools
+from heapq import heappop, heappush
 from typing import Any, Callable
 
 
@@ -13,21 +14,23 @@ class Scheduler:
     def __init__(self) -> None:
         self.now = 0.0
         self._heap: list[tuple[float, int, Callable[..., Any], tuple]] = []
-        self._seq = 0
+        self._seq = itertools.count()
 
     def at(self, t: float, fn: Callable[..., Any], *args: Any) -> None:
         if t < self.now:
             t = self.now
-        heapq.heappush(self._heap, (t, self._seq, fn, args))
-        self._seq += 1
+        heappush(self._heap, (t, next(self._seq), fn, args))
 
     def after(self, delay: float, fn: Callable[..., Any], *args: Any) -> None:
-        self.at(self.now + delay, fn, *args)
+        """`at(now + delay, ...)`, one call less: every node timer comes through here (NodeHardware.after)."""
+        now = self.now
+        t = now + delay
+        heappush(self._heap, (t if t >= now else now, next(self._seq), fn, args))
 
     def run_until(self, t_end: float) -> None:
         heap = self._heap
         while heap and heap[0][0] <= t_end:
-            t, _, fn, args = heapq.heappop(heap)
+            t, _, fn, args = heappop(heap)
             self.now = t
             fn(*args)
         self.now = max(self.now, t_end)

@@ -30,7 +30,7 @@ class NodeHardware:
         return self.sched.now
 
     def after(self, delay: float, fn: Callable[..., Any], *args: Any) -> None:
-        self.sched.at(self.sched.now + delay, self._fire, fn, args)
+        self.sched.after(delay, self._fire, fn, args)
 
     def _fire(self, fn: Callable[..., Any], args: tuple) -> None:
         if self.alive:

@@ -116,6 +116,7 @@ def trace_lines(frames: Iterable[Any], notes: Iterable[tuple[float, str, str, di
     return [row for _t, _k, row in rows]
 
 
+@functools.lru_cache(maxsize=1 << 16)      # a trace repeats most of its frames (_reading); the validator only reads
 def _parse_or_none(data: bytes) -> Parsed | None:
     try:
         return parse(data)
@@ -123,6 +124,7 @@ def _parse_or_none(data: bytes) -> Parsed | None:
         return None
 
 
+@functools.lru_cache(maxsize=1 << 16)
 def _intact(data: bytes | None) -> bool:
     if data is None:
         return False
