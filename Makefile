@@ -35,8 +35,9 @@ timing: setup
 	$(ARACHNAE) timing
 
 ## The scenario library, seeds 1-5 each (issue 14; the 1-20 sweep is sweep-suite), every expectation must hold.
+## A passing run keeps trace.tsv and metrics.json; a failing one every output (report.html, pictures, capture).
 scenarios: setup
-	$(ARACHNAE) sim batch $(filter-out scenarios/bench_60s.yaml,$(wildcard scenarios/*.yaml)) --seeds 1-5 -j 2 --out runs/batch
+	$(ARACHNAE) sim batch $(filter-out scenarios/bench_60s.yaml,$(wildcard scenarios/*.yaml)) --seeds 1-5 -j 2 --out runs/batch --outputs failed
 
 ## The scenario library over seeds 1-20 on a local Dask cluster, then pass rates (issue 14; not run in CI).
 sweep-suite: setup

@@ -41,6 +41,9 @@ def register(sub: Any) -> None:
     batch.add_argument("--out", default="sim-out", help="parent folder of the runs' output folders")
     batch.add_argument("--force", action="store_true",
                        help="replace existing run folders (and summary.md) even if they are not previous runs")
+    batch.add_argument("--outputs", choices=("all", "failed"), default="all",
+                       help="which runs write every output (default all); with `failed` a passing run's folder holds "
+                            "trace.tsv and metrics.json only (no pcapng, pictures or report.html: ~10 %% of a run)")
     batch.set_defaults(func=cmd_batch)
 
     sweep = ssub.add_parser("sweep", help="run a fault sweep (many runs, parameters varied) on a Dask cluster")
@@ -177,13 +180,14 @@ def cmd_run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _batch_one(job: tuple[str, int, str, bool]) -> tuple[str, int, dict[str, Any] | None, list, str | None]:
+def _batch_one(job: tuple[str, int, str, bool, bool]) -> tuple[str, int, dict[str, Any] | None, list, str | None]:
     from sim2d import runner
 
-    path, seed, out_root, force = job
+    path, seed, out_root, force, all_outputs = job
     try:
         outcome = runner.run(path, seed)
-        runner.write_outputs(outcome, Path(out_root) / f"{outcome.scenario.name}-seed{seed}", force=force)
+        runner.write_outputs(outcome, Path(out_root) / f"{outcome.scenario.name}-seed{seed}", force=force,
+                             full=all_outputs or bool(outcome.failed))
         return path, seed, outcome.result.metrics, outcome.expectations, None
     except UserError as exc:
         return path, seed, None, [], str(exc)
@@ -212,7 +216,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
                 raise UserError(f"{p}: writes {target}, as {targets[target]} does (give one a different name)")
             targets[target] = p
             check_target(target, args.force)     # refuse what a run would clobber before any run starts
-    jobs = [(p, s, args.out, args.force) for p in args.scenarios for s in seeds]
+    jobs = [(p, s, args.out, args.force, args.outputs == "all") for p in args.scenarios for s in seeds]
     rows = []
     with ProcessPoolExecutor(max_workers=args.jobs) as pool:
         for row in tqdm(pool.map(_batch_one, jobs), total=len(jobs), desc="sim batch", unit="run", file=sys.stderr):

@@ -109,12 +109,10 @@ def check_target(out_dir: str | Path, force: bool = False) -> Path:
     return out
 
 
-def write_outputs(outcome: Outcome, out_dir: str | Path, gif: bool = False, force: bool = False) -> Path:
-    """trace.tsv, bus.pcapng, metrics.json, run.png (and run.gif), report.html into a new folder, then moved to out_dir (check_target)."""
-    from captures.pcapng import bus_interfaces, write_file
-    from sim2d.render import render_gif, render_png
-    from sim2d.report import write_report
-
+def write_outputs(outcome: Outcome, out_dir: str | Path, gif: bool = False, force: bool = False,
+                  full: bool = True) -> Path:
+    """trace.tsv, bus.pcapng, metrics.json, run.png (and run.gif), report.html into a new folder, then moved to out_dir
+    (check_target). Not `full`: trace.tsv and metrics.json only (a passing run of `sim batch --outputs failed`)."""
     out = check_target(out_dir, force)
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
@@ -127,23 +125,11 @@ def write_outputs(outcome: Outcome, out_dir: str | Path, gif: bool = False, forc
         with open(tmp / "trace.tsv", "w") as fh:
             fh.write("\t".join(COLUMNS) + "\n")
             fh.write("\n".join(lines) + ("\n" if lines else ""))
-        # the same frames for Wireshark: one interface per bus, the spec's user link type (issue 13)
-        write_file(tmp / "bus.pcapng", bus_interfaces(outcome.spec or load_spec_once()), capture_frames(r.frames))
         metrics = dict(r.metrics)
         metrics["expectations"] = [{"name": n, "passed": ok, "detail": d} for n, ok, d in outcome.expectations]
         (tmp / "metrics.json").write_text(json.dumps(metrics, indent=2) + "\n")
-        render_png(r, str(tmp / "run.png"))
-        for node in r.nodes.values():         # debug-port dumps a node offers (e.g. the NP3's map)
-            artifacts = getattr(node, "write_artifacts", None)
-            if artifacts is not None:
-                artifacts(tmp)
-        ssc = r.nodes.get("SSC")
-        if outcome.scenario.speech_wav and ssc is not None:   # scenario `speech: {wav: true}`
-            ssc.write_wavs(tmp / "speech")
-        (tmp / "rcp_screen.vt100").write_bytes(outcome.rcp_screen)   # the UIC/RCP's terminal output
-        if gif:
-            render_gif(r, str(tmp / "run.gif"))
-        write_report(outcome, tmp)               # report.html, from the outputs above (issue 13)
+        if full:
+            _write_views(outcome, tmp, gif)
         sc = outcome.scenario
         (tmp / RUN_MARKER).write_text(json.dumps({"scenario": sc.path, "name": sc.name, "seed": sc.seed}) + "\n")
         os.chmod(tmp, 0o755)
@@ -155,6 +141,29 @@ def write_outputs(outcome: Outcome, out_dir: str | Path, gif: bool = False, forc
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     return out
+
+
+def _write_views(outcome: Outcome, tmp: Path, gif: bool) -> None:
+    """The run's capture, pictures, node artifacts and report.html (after trace.tsv and metrics.json) into `tmp`."""
+    from captures.pcapng import bus_interfaces, write_file
+    from sim2d.render import render_gif, render_png
+    from sim2d.report import write_report
+
+    r = outcome.result
+    # the same frames for Wireshark: one interface per bus, the spec's user link type (issue 13)
+    write_file(tmp / "bus.pcapng", bus_interfaces(outcome.spec or load_spec_once()), capture_frames(r.frames))
+    render_png(r, str(tmp / "run.png"))
+    for node in r.nodes.values():         # debug-port dumps a node offers (e.g. the NP3's map)
+        artifacts = getattr(node, "write_artifacts", None)
+        if artifacts is not None:
+            artifacts(tmp)
+    ssc = r.nodes.get("SSC")
+    if outcome.scenario.speech_wav and ssc is not None:   # scenario `speech: {wav: true}`
+        ssc.write_wavs(tmp / "speech")
+    (tmp / "rcp_screen.vt100").write_bytes(outcome.rcp_screen)   # the UIC/RCP's terminal output
+    if gif:
+        render_gif(r, str(tmp / "run.gif"))
+    write_report(outcome, tmp)               # report.html, from the outputs above (issue 13)
 
 
 def _move_into_place(tmp: Path, out: Path) -> None:

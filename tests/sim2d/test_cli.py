@@ -49,11 +49,15 @@ def test_bad_scenario_is_one_line_and_writes_nothing(tmp_path, write):
 def test_batch_runs_scenarios_times_seeds(tmp_path, write):
     a = write("a.yaml", "name: a\nduration: 2\narena: {size: [4, 3]}\nrobot: {pose: [1, 1, 0]}\nexpect: {post: OPERATIONAL}\n")
     b = write("b.yaml", "name: b\nduration: 2\narena: {size: [4, 3]}\nrobot: {pose: [1, 1, 0]}\nexpect: {never_moves: true, post: HALTED}\n")
-    p = cli("batch", str(a), str(b), "--seeds", "1-2", "-j", "2", "--out", str(tmp_path / "runs"))
+    p = cli("batch", str(a), str(b), "--seeds", "1-2", "-j", "2", "--out", str(tmp_path / "runs"), "--outputs", "failed")
     assert p.returncode == 1                      # b fails: POST is OPERATIONAL
     assert "2 passed, 2 failed" in p.stdout
     assert sorted(d.name for d in (tmp_path / "runs").iterdir()) == [".arachnae-batch", "a-seed1", "a-seed2",
                                                                      "b-seed1", "b-seed2", "summary.md"]
+    # --outputs failed: a passing run keeps its trace and metrics, a failing one everything (report.html, ...)
+    assert sorted(f.name for f in (tmp_path / "runs" / "a-seed1").iterdir()) == [".arachnae-run", "metrics.json",
+                                                                                 "trace.tsv"]
+    assert {"report.html", "bus.pcapng", "run.png"} <= {f.name for f in (tmp_path / "runs" / "b-seed1").iterdir()}
     rows = (tmp_path / "runs" / "summary.md").read_text().splitlines()[2:]   # one row per run, failures marked
     assert [r.split(" | ")[:3] for r in rows] == [["| a", "1", "PASS"], ["| a", "2", "PASS"],
                                                   ["| b", "1", "FAIL"], ["| b", "2", "FAIL"]]
