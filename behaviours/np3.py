@@ -35,8 +35,8 @@ from arachnae_proto.skeletons.np3 import Np3Skeleton
 from behaviours import tuning as T
 from behaviours.gait import STILL, Gait
 from behaviours.geometry import RobotGeometry
-from behaviours.np3_layers import (AVOIDANCE, REFLEXES, Tuning, body_frame, closing_in, np3_network, safe_instead,
-                                   steepness_deg, uphill)
+from behaviours.np3_layers import (AVOIDANCE, REFLEXES, TaskModule, Tuning, body_frame, closing_in, np3_network,
+                                   safe_instead, steepness_deg, uphill)
 from behaviours.runtime import Runtime
 from behaviours.topomap import (OCCUPIED, FrontierTarget, HeadingVotes, OccupancyGrid, Reading, TopoMap, heading_offset,
                                 ray_cells)
@@ -768,7 +768,11 @@ class NP3(Runtime, Np3Skeleton):
         (out / "control.tsv").write_text("\n".join(rows) + "\n")
         (out / "wiring.txt").write_text(self.layers.wiring_table() + "\n")
         self.map.rebuild()
-        self.map.save_png(out / "topomap.png", given_up=self.frontier_target.given_up)
+        task = self.layers.modules["task"]
+        # seeking a light the samples show, the task climbs its gradient and the map's plan is not followed
+        following = self.cfg.task == "seek_light" and isinstance(task, TaskModule) and not task.dark()
+        self.map.save_png(out / "topomap.png", given_up=self.frontier_target.given_up,
+                          plan=[] if following else None)
         plans = ["t_s\tx_m\ty_m\tkind\tfresh_m\troute"]
         plans += [f"{p.t:.2f}\t{p.x:.2f}\t{p.y:.2f}\t{p.kind}\t{p.fresh_m:.2f}\t"
                   + " ".join(f"{wx:.2f},{wy:.2f}" for wx, wy in p.route) for p in self.plans]
