@@ -411,7 +411,8 @@ class NP3(Runtime, Np3Skeleton):
         """seed 3.3.2 / 5.2: the task layer's next goal, every NP3_EXPLORE_PLAN_S or when it is reached.
 
         First choice: the heading whose ray through the map runs longest over cells not passed yet before a
-        mapped obstacle, with a goal along it (short of the obstacle). When no heading is open (boxed in by
+        mapped obstacle, with a goal along it (short of the obstacle; not a heading the robot was just kept
+        from, not_approached). When no heading is open (boxed in by
         walls, pits, refused slopes) or a route is being followed, a route over the topological map to the
         nearest frontier (free space bordering unknown space, at least NP3_PLAN_MIN_PATH_M away), waypoint
         by waypoint; it is planned again (the map has changed) every NP3_EXPLORE_PLAN_S.
@@ -759,7 +760,8 @@ class NP3(Runtime, Np3Skeleton):
         }
 
     def write_artifacts(self, out_dir: Path) -> None:
-        """control.tsv (the control trace), wiring.txt (the declared network) and topomap.png (seed 3.3.2)."""
+        """control.tsv (the control trace), wiring.txt (the declared network), topomap.png and plans.tsv (seed
+        3.3.2: the map with the plan followed at the end, and every plan made)."""
         out = Path(out_dir)
         rows = ["start_s\tend_s\tlayer\tmodule"]
         if "move" in self.layers.traces:
