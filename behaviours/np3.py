@@ -18,7 +18,7 @@ no compass is declared, and the behaviours never read the simulator's pose); exp
 heads along the map's least-passed open ray. A short local memory of echoes
 (sonar, IR, whiskers) at the DR pose lets wall following and avoidance see
 what the sensors saw seconds ago. debug_metrics() reports which layer held the
-MMC for how long; write_artifacts() writes control.tsv and topomap.png.
+MMC for how long; write_artifacts() writes control.tsv, topomap.png and plans.tsv (every plan, DR frame).
 """
 from __future__ import annotations
 
@@ -35,8 +35,8 @@ from arachnae_proto.skeletons.np3 import Np3Skeleton
 from behaviours import tuning as T
 from behaviours.gait import STILL, Gait
 from behaviours.geometry import RobotGeometry
-from behaviours.np3_layers import (AVOIDANCE, REFLEXES, Tuning, body_frame, closing_in, np3_network, safe_instead,
-                                   steepness_deg, uphill)
+from behaviours.np3_layers import (AVOIDANCE, REFLEXES, TaskModule, Tuning, body_frame, closing_in, np3_network,
+                                   safe_instead, steepness_deg, uphill)
 from behaviours.runtime import Runtime
 from behaviours.topomap import (OCCUPIED, FrontierTarget, HeadingVotes, OccupancyGrid, Reading, TopoMap, heading_offset,
                                 ray_cells)
@@ -226,6 +226,34 @@ class GaitReckoning(DeadReckoning):
         self.gait.set_command(cmd)                      # a gait (7..9) too: it changes the stroke's timing
 
 
+class OpenHeading(NamedTuple):
+    """explore's best ray through the map (NP3.open_heading)."""
+    score: float
+    heading: float          # rad, DR frame
+    free_m: float           # free length before a mapped obstacle
+    fresh_m: float          # of it, not yet passed
+
+
+class HeadingPlan(NamedTuple):
+    """explore's heading goal as set: judged at the next plan (NP3.not_approached)."""
+    x: float
+    y: float
+    heading: float
+    goal: tuple[float, float]
+    left_m: float                 # the goal's distance when set
+    fights: int                   # times a stronger layer had taken the actuator by then
+
+
+class PlanRecord(NamedTuple):
+    """One task-layer decision (seed 3.3.2), kept for plans.tsv: where the robot thought it was, what it chose."""
+    t: float
+    x: float
+    y: float
+    kind: str                               # "heading" (the map's least-passed open ray), "frontier" (a route), "none"
+    fresh_m: float                          # the best heading's not-yet-passed length (explore; 0 otherwise)
+    route: tuple[tuple[float, float], ...]  # the waypoints planned, the goal last
+
+
 class Np3Map(TypedDict):
     places: int
     edges: int
@@ -300,6 +328,9 @@ class NP3(Runtime, Np3Skeleton):
         self.goal: tuple[float, float] | None = None
         self.routes_planned = 0               # routes planned over the topological map (3.3.2)
         self.frontier_target = FrontierTarget(T.NP3_PLAN_EXCLUDE_M, T.NP3_PLAN_PROGRESS_M, T.NP3_PLAN_PATIENCE_S)
+        self.plans: list[PlanRecord] = []     # every full plan, for plans.tsv (what was planned vs what happened)
+        self.heading_plan: HeadingPlan | None = None
+        self.blocked: deque[HeadingPlan] = deque(maxlen=T.NP3_EXPLORE_BLOCKED_KEEP)   # headings not approached
         self.visited: set[tuple[int, int]] = set()
         self.heading_votes = HeadingVotes(T.NP3_MATCH_VOTES, T.NP3_MATCH_GAIN, math.radians(T.NP3_MATCH_STEP_DEG))
         self.heading_fixed = 0.0              # the heading corrections from the map, summed (rad, debug metrics)
@@ -380,7 +411,8 @@ class NP3(Runtime, Np3Skeleton):
         """seed 3.3.2 / 5.2: the task layer's next goal, every NP3_EXPLORE_PLAN_S or when it is reached.
 
         First choice: the heading whose ray through the map runs longest over cells not passed yet before a
-        mapped obstacle, with a goal along it (short of the obstacle). When no heading is open (boxed in by
+        mapped obstacle, with a goal along it (short of the obstacle; not a heading the robot was just kept
+        from, not_approached). When no heading is open (boxed in by
         walls, pits, refused slopes) or a route is being followed, a route over the topological map to the
         nearest frontier (free space bordering unknown space, at least NP3_PLAN_MIN_PATH_M away), waypoint
         by waypoint; it is planned again (the map has changed) every NP3_EXPLORE_PLAN_S.
@@ -402,17 +434,58 @@ class NP3(Runtime, Np3Skeleton):
         self.planned_at = now
         self.next_plan = now + T.NP3_EXPLORE_PLAN_S
         self.map.plan = []
+        self.not_approached(x, y)
         if self.cfg.task == "seek_light":          # searching for a light it cannot see: the nearest unknown
             # the widest opening onto the unknown first, round walls by the map (a lamp behind a wall)
             self.goal = self.route_to_frontier(x, y, now, T.NP3_SEEK_FRONTIER_WEIGHT_M)
             if self.goal is not None:
-                self.layers.sense(goal=self.goal)
+                self.chose(now, "frontier", 0.0)
                 return
+        best = self.open_heading(x, y, th)
+        if best is not None:
+            length = min(best.free_m - T.NP3_EXPLORE_MARGIN_M, T.NP3_EXPLORE_GOAL_M)
+            self.goal = (x + length * math.cos(best.heading), y + length * math.sin(best.heading))
+            self.map.plan = [self.goal]            # the picture shows it (topomap.png)
+            self.heading_plan = HeadingPlan(x, y, best.heading, self.goal, length, self.fights())
+            self.chose(now, "heading", best.fresh_m)
+        else:
+            self.goal = self.route_to_frontier(x, y, now)
+            self.chose(now, "frontier" if self.goal is not None else "none", 0.0)
+
+    def fights(self) -> int:
+        """How often a layer above the task (avoidance, reflexes) has taken the actuator so far."""
+        return sum(n for module, n in self.takeovers.items() if module != "task")
+
+    def not_approached(self, x: float, y: float) -> None:
+        """The last heading goal, if the robot came no NP3_PLAN_PROGRESS_M nearer it while a stronger layer
+        took the actuator, is blocked where the map shows it open (a surface mapped off its place, a thin end
+        the sonar misses): that heading is not chosen again near here. Else the same free ray was chosen
+        every plan and avoidance turned the robot back each time, 30-40 s on the spot (maze_far_room seed 9,
+        issue 17)."""
+        hp, self.heading_plan = self.heading_plan, None
+        if hp is None or self.fights() == hp.fights:
+            return
+        if math.dist(hp.goal, (x, y)) > max(hp.left_m - T.NP3_PLAN_PROGRESS_M, T.NP3_GOAL_REACHED_M):
+            self.blocked.append(hp._replace(x=x, y=y))
+
+    def chose(self, now: float, kind: str, fresh_m: float) -> None:
+        """Hand the goal to the task layer and log the plan."""
+        x, y, _ = self.odo.pose
+        self.plans.append(PlanRecord(now, x, y, kind, fresh_m, tuple(self.map.plan)))
+        self.layers.sense(goal=self.goal)
+
+    def open_heading(self, x: float, y: float, th: float) -> OpenHeading | None:
+        """The heading whose ray through the map runs longest over cells not passed yet before a mapped
+        obstacle (turns cost a little, long free rays count a little); None when no ray is free past
+        NP3_EXPLORE_MARGIN_M."""
         g = self.map.grid
-        best: tuple[float, float, float] | None = None          # (score, heading, free length)
+        best: OpenHeading | None = None
         for k in range(T.NP3_EXPLORE_HEADINGS):
             turn = (2 * math.pi * k / T.NP3_EXPLORE_HEADINGS + math.pi) % (2 * math.pi) - math.pi
             h = th + turn
+            if any(math.dist((b.x, b.y), (x, y)) < T.NP3_EXPLORE_BLOCKED_M
+                   and abs(wrap_angle(h - b.heading)) < math.radians(T.NP3_EXPLORE_BLOCKED_DEG) for b in self.blocked):
+                continue
             free = fresh = 0.0
             for cell in ray_cells(x, y, h, T.NP3_EXPLORE_REACH_M, g.res, g.x0, g.y0):
                 if not g.inside(*cell) or g.state(*cell) == OCCUPIED:
@@ -420,14 +493,9 @@ class NP3(Runtime, Np3Skeleton):
                 free = math.dist((x, y), g.centre(*cell))
                 fresh += g.res * (cell not in self.visited)
             score = fresh + 0.2 * free - 0.3 * abs(turn)
-            if free > T.NP3_EXPLORE_MARGIN_M and (best is None or score > best[0]):
-                best = (score, h, free)
-        if best is not None:
-            length = min(best[2] - T.NP3_EXPLORE_MARGIN_M, T.NP3_EXPLORE_GOAL_M)
-            self.goal = (x + length * math.cos(best[1]), y + length * math.sin(best[1]))
-        else:
-            self.goal = self.route_to_frontier(x, y, now)
-        self.layers.sense(goal=self.goal)
+            if free > T.NP3_EXPLORE_MARGIN_M and (best is None or score > best.score):
+                best = OpenHeading(score, h, free, fresh)
+        return best
 
     def route_to_frontier(self, x: float, y: float, now: float, size_weight: float = 0.0) \
             -> tuple[float, float] | None:
@@ -692,7 +760,8 @@ class NP3(Runtime, Np3Skeleton):
         }
 
     def write_artifacts(self, out_dir: Path) -> None:
-        """control.tsv (the control trace), wiring.txt (the declared network) and topomap.png (seed 3.3.2)."""
+        """control.tsv (the control trace), wiring.txt (the declared network), topomap.png and plans.tsv (seed
+        3.3.2: the map with the plan followed at the end, and every plan made)."""
         out = Path(out_dir)
         rows = ["start_s\tend_s\tlayer\tmodule"]
         if "move" in self.layers.traces:
@@ -701,4 +770,12 @@ class NP3(Runtime, Np3Skeleton):
         (out / "control.tsv").write_text("\n".join(rows) + "\n")
         (out / "wiring.txt").write_text(self.layers.wiring_table() + "\n")
         self.map.rebuild()
-        self.map.save_png(out / "topomap.png", given_up=self.frontier_target.given_up)
+        task = self.layers.modules["task"]
+        # seeking a light the samples show, the task climbs its gradient and the map's plan is not followed
+        following = self.cfg.task == "seek_light" and isinstance(task, TaskModule) and not task.dark()
+        self.map.save_png(out / "topomap.png", given_up=self.frontier_target.given_up,
+                          plan=[] if following else None)
+        plans = ["t_s\tx_m\ty_m\tkind\tfresh_m\troute"]
+        plans += [f"{p.t:.2f}\t{p.x:.2f}\t{p.y:.2f}\t{p.kind}\t{p.fresh_m:.2f}\t"
+                  + " ".join(f"{wx:.2f},{wy:.2f}" for wx, wy in p.route) for p in self.plans]
+        (out / "plans.tsv").write_text("\n".join(plans) + "\n")

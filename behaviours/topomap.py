@@ -528,9 +528,11 @@ class TopoMap:
 
     # -- picture --------------------------------------------------------------------
     def save_png(self, path: str | Path, px_per_cell: int = 4,
-                 given_up: Sequence[tuple[float, float]] = ()) -> Path:
+                 given_up: Sequence[tuple[float, float]] = (),
+                 plan: Sequence[tuple[float, float]] | None = None) -> Path:
         """Grid (unknown grey, free white, occupied black), room outline, edges, places, robot path, the plan
-        (green, to a square at its goal) and frontiers given up (FrontierTarget, purple crosses)."""
+        (green, to a square at its goal; `plan` instead of self.plan when the caller knows better) and
+        frontiers given up (FrontierTarget, purple crosses)."""
         from PIL import Image, ImageDraw
 
         g, s = self.grid, px_per_cell
@@ -557,8 +559,9 @@ class TopoMap:
             draw.ellipse((cx - r, cy - r, cx + r, cy + r), fill=(220, 30, 30))
         if len(self.path) > 1:
             draw.line([px(*p) for p in self.path], fill=(230, 140, 0), width=2)
-        if self.plan:                                  # the route being followed, from the robot on
-            pts = [px(*p) for p in ([self.path[-1]] if self.path else []) + self.plan]
+        plan = self.plan if plan is None else list(plan)
+        if plan:                                       # the route being followed, from the robot on
+            pts = [px(*p) for p in ([self.path[-1]] if self.path else []) + plan]
             draw.line(pts, fill=(0, 170, 60), width=3)
             (gx, gy), r = pts[-1], max(5, 2 * s)
             draw.rectangle((gx - r, gy - r, gx + r, gy + r), outline=(0, 170, 60), width=2)

@@ -194,6 +194,8 @@ def test_a_route_goes_round_through_the_door_and_never_through_the_wall(tmp_path
     assert any(img.getpixel((x, y)) == (0, 170, 60) for x in range(img.width) for y in range(0, img.height, 2))
     i, j = opened.grid.cell(1.0, 1.0)                              # a frontier given up: a cross there
     assert img.getpixel((i * 4 + 2, (opened.grid.ny - 1 - j) * 4 + 2)) == (150, 40, 170)
+    none = Image.open(opened.save_png(tmp_path / "none.png", plan=[])).convert("RGB")   # a plan not followed
+    assert all(none.getpixel((x, y)) != (0, 170, 60) for x in range(none.width) for y in range(0, none.height, 2))
 
 
 def test_pits_found_are_barriers_and_the_route_takes_their_one_gap_then_replans_when_it_closes():
