@@ -204,6 +204,10 @@ class GaitReckoning(DeadReckoning):
     a start or a turn, and a stance foot at its stroke's end holds the body until it has stepped, so a turn
     after walking turned 8.8-23 deg/s over its first seconds (issue 17: the heading ended 16-74 deg off).
     The model has those pauses; the sensors are not needed for it, and the simulator's pose is not read.
+    What the MMC does on its own the copy does when the MMC's STATUS tells (NP3.stopped_by_mmc, leg_lost).
+    Not modelled (issue 17, s10-heading): feet sliding along an obstacle's face turn the body with no report
+    to the NP3 (seek_light seed 4 at 71-78 s: +67 deg while walking FORWARD, the sim's blocked-foot count
+    21 -> 55, no LEG_DRIVE_BLOCKED relayed, no heading vote): only the map can tell that.
     The history: a leg after each gait step that moved the body; its rates are zero, so between two steps
     (one MMC control period) the pose holds.
     """
