@@ -360,8 +360,11 @@ def test_wall_following_holds_the_band_with_sidesteps_and_turns_at_corners(wall_
 def test_exploring_sets_a_goal_short_of_the_mapped_walls(spec):
     metres = quantizer(M.XmitDataUsrc, "distance")
     rig = np3(spec, task="explore")
-    for k in range(0, 360, 5):                                               # walls 1.5 m all round
-        rig.inject(0.1 + k / 400, MCP, data("USRC", metres.raw(1.5), VALUE, channel=k))
+    # walls 1.5 m all round; the robot turns while the head sweeps (about 20 deg, as far as the reckoning's turn
+    # grip says), so the sweep runs on 40 deg past its start to close the ring in the world (it ended 20 deg short
+    # of it and the goal lay outside, through the gap: s10-heading, with the tripod's grip at 0.95 / 0.955)
+    for k in range(0, 400, 5):
+        rig.inject(0.1 + k / 400, MCP, data("USRC", metres.raw(1.5), VALUE, channel=k % 360))
     rig.run(11.0)                                                            # the 10 s re-plan saw the sweep
     goal = rig.node.goal
     x, y, _th = rig.node.odo.pose
