@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 from collections import deque
 from pathlib import Path
-from typing import Any, NamedTuple, TypedDict, TypeVar
+from typing import Any, Mapping, NamedTuple, TypedDict, TypeVar
 
 from arachnae_proto import messages as M
 from arachnae_proto.enums import MmcError, MovCmd, RangeStatus, RecordKind, TpscContact
@@ -33,7 +33,7 @@ from arachnae_proto.network import ADDRESS_OF, NODES
 from arachnae_proto.skeletons.np3 import Np3Skeleton
 
 from behaviours import tuning as T
-from behaviours.gait import STILL, Gait
+from behaviours.gait import FIVE_LEGGED, STILL, Gait
 from behaviours.geometry import RobotGeometry
 from behaviours.np3_layers import (AVOIDANCE, REFLEXES, TaskModule, Tuning, body_frame, closing_in, np3_network,
                                    safe_instead, steepness_deg, uphill)
@@ -45,6 +45,7 @@ from behaviours.units import RECORD_AGE, RECORD_QUANTIZER, Quantizer, from_recor
 _VALUE, _ALARM, _STATUS = int(RecordKind.VALUE), int(RecordKind.ALARM), int(RecordKind.STATUS)
 _IR_BAD = {int(RangeStatus.UNRELIABLE), int(RangeStatus.OUT_OF_ORDER)}
 _NO_GROUND, _BLOCKED = int(MmcError.NO_GROUND), int(MmcError.LEG_DRIVE_BLOCKED)
+_LEG_LOST = {int(MmcError.LCP_OUT_OF_ORDER), int(MmcError.JAC_OUT_OF_ORDER)}
 _STOP, _FORWARD, _BACKWARD = int(MovCmd.STOP), int(MovCmd.FORWARD), int(MovCmd.BACKWARD)
 _LEFT, _RIGHT = int(MovCmd.TURN_LEFT), int(MovCmd.TURN_RIGHT)
 _SIDE_L, _SIDE_R = int(MovCmd.SIDESTEP_LEFT), int(MovCmd.SIDESTEP_RIGHT)
@@ -170,6 +171,9 @@ class DeadReckoning:
             self.cmd = cmd
             self.keep(now)
 
+    def leg_lost(self, now: float, leg: int) -> None:
+        """A leg is out of order (seed 6.3): the constant rates do not know how fast five legs walk."""
+
     def pose_at(self, t: float) -> tuple[float, float, float]:
         """The pose at time t (not after the last advance): on the leg running then (issue 17)."""
         if self.t is None or t >= self.t:
@@ -200,14 +204,26 @@ class GaitReckoning(DeadReckoning):
     a start or a turn, and a stance foot at its stroke's end holds the body until it has stepped, so a turn
     after walking turned 8.8-23 deg/s over its first seconds (issue 17: the heading ended 16-74 deg off).
     The model has those pauses; the sensors are not needed for it, and the simulator's pose is not read.
+    What the MMC does on its own the copy does when the MMC's STATUS tells (NP3.stopped_by_mmc, leg_lost).
+    Not modelled (issue 17, s10-heading): feet sliding along an obstacle's face turn the body with no report
+    to the NP3 (seek_light seed 4 at 71-78 s: +67 deg while walking FORWARD, the sim's blocked-foot count
+    21 -> 55, no LEG_DRIVE_BLOCKED relayed, no heading vote): only the map can tell that.
     The history: a leg after each gait step that moved the body; its rates are zero, so between two steps
     (one MMC control period) the pose holds.
     """
 
-    def __init__(self, geometry: RobotGeometry, grip: float, turn_grip: float, step_s: float) -> None:
+    def __init__(self, geometry: RobotGeometry, grip: float, turn_grip: Mapping[str, float], step_s: float) -> None:
         super().__init__(0.0, 0.0, 0.0)
         self.gait = Gait(geometry)
-        self.grip, self.turn_grip, self.step_s = grip, turn_grip, step_s
+        self.grip, self.step_s = grip, step_s
+        self.turn_grips = {int(MovCmd[name]): g for name, g in turn_grip.items()}
+        self.turn_grips[FIVE_LEGGED] = self.turn_grips[int(MovCmd.WAVE)]      # seed 6.3: a wave over five legs
+
+    @property
+    def turn_grip(self) -> float:
+        """The share of the running pattern's turn the body makes (measured per gait: a tripod's three stance feet
+        slip more than a ripple's or a wave's four or five)."""
+        return self.turn_grips[self.gait.running]
 
     def advance(self, now: float) -> None:
         if self.t is None:
@@ -224,6 +240,11 @@ class GaitReckoning(DeadReckoning):
     def command(self, now: float, cmd: int) -> None:
         super().command(now, cmd)
         self.gait.set_command(cmd)                      # a gait (7..9) too: it changes the stroke's timing
+
+    def leg_lost(self, now: float, leg: int) -> None:
+        """seed 6.3: the MMC walks on five legs (its STATUS says a leg is out of order): so does the copy."""
+        self.advance(now)
+        self.gait.drop_leg(leg)
 
 
 class OpenHeading(NamedTuple):
@@ -289,11 +310,9 @@ class NP3(Runtime, Np3Skeleton):
         self.running = False
         self.tuning = Tuning()
         self.layers = np3_network(lambda: self.now, self.cfg.task, self.tuning)
-        # the tasks that plan on the map reckon through the gait model; the others keep the measured constant rates
-        # for now: with the gait model, obstacle_course seed 5 (14 contacts) and worst_contention seed 4 (reaction
-        # 0.95 s > 0.65) failed, with the constant rates they pass; the cause is not found yet (s9-light, issue 17)
-        self.odo = (GaitReckoning(g, T.NP3_DR_GRIP, T.NP3_DR_TURN_GRIP, T.MMC_CONTROL_S) if True
-                    else DeadReckoning(T.NP3_DR_SPEED_M_S, math.radians(T.NP3_DR_TURN_DEG_S), T.NP3_DR_SIDE_M_S))
+        # every task reckons through the gait model (issue 17, s10-heading: exp9's obstacle_course seed 5 and
+        # worst_contention seed 4, which failed with it on s9-light, pass; bench/dr_heading.py measures it)
+        self.odo: DeadReckoning = GaitReckoning(g, T.NP3_DR_GRIP, T.NP3_DR_TURN_GRIP, T.MMC_CONTROL_S)
         self.geo = g
         self.echoes: deque[Echo] = deque()
         self.pings: deque[Ping] = deque()                 # the sonar's recent free space (issue 17)
@@ -609,8 +628,14 @@ class NP3(Runtime, Np3Skeleton):
         r = self.net.reflex_from(source)
         if r is None or r.to != ADDRESS_OF["MMC"]:
             return
-        self.odo.command(self.now, int(MovCmd[r.command]))
-        self.sent = (int(MovCmd[r.command]), "reflex")
+        self.stopped_by_mmc(int(MovCmd[r.command]))
+
+    def stopped_by_mmc(self, cmd: int) -> None:
+        """The MMC walks `cmd` now though the NP3 did not send it (a reflex, or its own stop at a pit): the
+        reckoning walks it too (no motion counted that the legs did not make), and the network's next command
+        goes out even if it equals what we sent last."""
+        self.odo.command(self.now, cmd)
+        self.sent = (cmd, "reflex")
 
     def bump(self, register: str, *data: Any) -> None:
         self.seq[register] += 1
@@ -620,6 +645,7 @@ class NP3(Runtime, Np3Skeleton):
         """MMC STATUS_ACK error as the MCP relays it: a pit or a blocked leg starts a reflex once per report."""
         if (error, leg) != self.mmc_error:
             if error == _NO_GROUND:                  # seed 1.2.2: where the foot found no ground, in the body frame
+                self.stopped_by_mmc(_STOP)           # ... the MMC stopped there at once (mmc.py, seed 1.2.2)
                 fx, fy = self.geo.neutral_foot(leg) if leg in self.geo.legs else (self.geo.hip_x[0], 0.0)
                 self.echo(fx, fy, 0.0, 0.0)          # the edge joins the local memory (the motion check) ...
                 self.map.grid.mark_barrier(*self.at_body(fx, fy))   # ... and the map: the pit is part of it (3.3.2)
@@ -627,6 +653,8 @@ class NP3(Runtime, Np3Skeleton):
                 self.bump("pit", fx, fy)
             elif error == _BLOCKED:
                 self.bump("leg_blocked", self.geo.side(leg) if leg in self.geo.legs else 0.0)
+            elif error in _LEG_LOST and leg in self.geo.legs:
+                self.odo.leg_lost(self.now, leg)     # seed 6.3: the MMC walks on five from now on
         self.mmc_error = (error, leg)
 
     def range_status(self, role: str, status: int) -> None:

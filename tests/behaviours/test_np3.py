@@ -606,3 +606,47 @@ def test_the_ping_straight_ahead_clears_the_inner_edge_of_the_ping_15_deg_off(sp
     left = [e for e in node.echoes if e.sonar]
     assert left and min(abs(e.y) for e in left) > band
     assert max(e.y for e in left) == pytest.approx(0.25, abs=0.01)     # the wall's point stays
+
+
+def test_the_reckoning_stops_where_the_mmc_stopped_at_a_pit(spec):
+    """seed 1.2.2 + issue 17 (s10-heading): the MMC stops at once when a foot finds no ground; the NP3 learns it
+    from the STATUS record. Its reckoning counts no walking from then on (the legs made none), and the command
+    it wants next goes out to the MMC even when it is the one sent before (a rear foot's pit: walk on forwards)."""
+    rig = np3(spec)
+    rig.run(1.0)
+    walked = rig.node.pose_at(None)[0]
+    assert walked > 0.02 and command_at(rig, 1.0) == MovCmd.FORWARD
+    rig.inject(1.0, MCP, data("MMC", int(MmcError.NO_GROUND), STATUS, channel=3))   # leg 3: rear left
+    rig.run(1.5)
+    after = [t for t, m in moves(rig) if t >= 1.0]
+    assert after and command_at(rig, 1.5) == MovCmd.FORWARD           # sent again: the MMC had stopped
+    assert rig.node.odo.pose_at(after[0] - 0.01)[0] == pytest.approx(rig.node.odo.pose_at(1.0)[0], abs=1e-3)
+
+
+def test_a_lost_leg_walks_the_reckonings_gait_on_five_legs_with_the_waves_grip(spec):
+    """seed 6.3 + issue 17: a leg out of order (the MMC's STATUS) makes the MMC walk the five-legged wave; the
+    NP3's copy of the gait drops the leg too, so its turns and strides follow the wave's, at the wave's grip."""
+    rig = np3(spec)
+    rig.run(0.5)
+    odo = rig.node.odo
+    assert odo.turn_grip == T.NP3_DR_TURN_GRIP["TRIPOD"]
+    rig.inject(0.5, MCP, data("MMC", int(MmcError.LCP_OUT_OF_ORDER), STATUS, channel=2))
+    rig.run(4.0)
+    assert odo.gait.lost == {2} and 2 not in odo.gait.legs
+    assert odo.turn_grip == T.NP3_DR_TURN_GRIP["WAVE"]
+
+
+def test_the_reckonings_turn_grip_is_the_running_gaits():
+    """issue 17: measured per gait (tuning.NP3_DR_TURN_GRIP): the same turn commanded in the ripple counts the
+    ripple's share of the model's turn, in the tripod the tripod's."""
+    turned = {}
+    for gait in ("TRIPOD", "RIPPLE"):
+        odo = GaitReckoning(DEFAULT_GEOMETRY, T.NP3_DR_GRIP, T.NP3_DR_TURN_GRIP, T.MMC_CONTROL_S)
+        bare = GaitReckoning(DEFAULT_GEOMETRY, T.NP3_DR_GRIP, dict.fromkeys(T.NP3_DR_TURN_GRIP, 1.0), T.MMC_CONTROL_S)
+        for r in (odo, bare):
+            r.command(0.0, int(MovCmd[gait]))
+            r.command(0.0, int(MovCmd.TURN_LEFT))
+            r.advance(4.0)
+        assert bare.th > math.radians(30)
+        turned[gait] = odo.th / bare.th
+    assert turned == pytest.approx({g: T.NP3_DR_TURN_GRIP[g] for g in turned}, abs=1e-9)

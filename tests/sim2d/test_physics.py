@@ -78,7 +78,7 @@ def test_the_np3s_dead_reckoning_through_the_gait_model_keeps_its_heading(write)
     drifted 16-74 deg in a run). The NP3's copy of the gait, fed the same commands, keeps within a few degrees."""
     plan = [(FORWARD, 2.6), (TURN_LEFT, 1.0)] * 4 + [(FORWARD, 2.6), (TURN_RIGHT, 1.3)] * 2
     r = drive(write("s.yaml", ROOM.replace("[6, 4]", "[12, 12]").replace("[1, 2, 0]", "[6, 6, 0]")), plan)
-    odo = GaitReckoning(P, T.NP3_DR_GRIP, T.NP3_DR_GRIP, T.MMC_CONTROL_S)   # bare gait: no LCP
+    odo = GaitReckoning(P, T.NP3_DR_GRIP, dict.fromkeys(T.NP3_DR_TURN_GRIP, T.NP3_DR_GRIP), T.MMC_CONTROL_S)   # bare gait: no LCP
     const = DeadReckoning(T.NP3_DR_SPEED_M_S, math.radians(T.NP3_DR_TURN_DEG_S), T.NP3_DR_SIDE_M_S)
     t = 0.0
     for command, seconds in plan:
