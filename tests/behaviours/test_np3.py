@@ -406,6 +406,22 @@ def test_a_refused_walk_turns_away_from_what_it_would_close_in_on():
     assert safe_instead(mirrored, MovCmd.FORWARD, t) == MovCmd.TURN_RIGHT
 
 
+def test_a_refused_walk_sidesteps_off_a_wall_alongside_when_turning_would_swing_into_it():
+    """corridor_narrow seeds 18, 19: a few degrees off the corridor's axis, the right-hand wall 9 cm off the right
+    flank and its echo 0.25 m ahead-right refuse FORWARD; either turn swings an end of the body into the wall,
+    and backing off and walking on met the same wall again and again. The guard steps away from it instead."""
+    from behaviours.np3_layers import closing_in, safe_instead
+    t = Tuning()
+    right_wall = [(x / 20, -0.17, -90.0, 0.0) for x in range(-4, 3)]
+    left_wall = [(x / 20, 0.30, 90.0, 0.0) for x in range(-4, 5)]
+    pts = [(0.25, -0.112, -15.0, 0.056), *right_wall, *left_wall]
+    assert closing_in(pts, MovCmd.FORWARD, t) > 0
+    assert closing_in(pts, MovCmd.TURN_LEFT, t) > 0 and closing_in(pts, MovCmd.TURN_RIGHT, t) > 0
+    assert safe_instead(pts, MovCmd.FORWARD, t) == MovCmd.SIDESTEP_LEFT
+    mirrored = [(bx, -by, -s, a) for bx, by, s, a in pts]
+    assert safe_instead(mirrored, MovCmd.FORWARD, t) == MovCmd.SIDESTEP_RIGHT
+
+
 def test_a_refused_command_hands_the_actuator_to_the_guard_reflex(spec):
     rig = np3(spec)
     rig.run(1.0)
