@@ -424,11 +424,20 @@ def safe_instead(points: list[Point], cmd: Any, t: Tuning) -> Any:
     turn towards the freer side, back off), STOP when nothing is safe. A turn refused whose other way turns
     towards the crowded side (a wall along one flank that also closes in ahead: the end swings into it one
     way, the nose the other) sidesteps away from that side first: turning back towards it undid the
-    avoidance that had turned away, and the two took turns in front of the wall (scenarios/sonar_first.yaml)."""
+    avoidance that had turned away, and the two took turns in front of the wall (scenarios/sonar_first.yaml).
+    A walk refused turns first away from the side of the echoes it would close in on, whatever else lies round
+    the body: choosing by the crowd turned the robot towards the very wall ahead of it (corridor_narrow seed 3:
+    the right-hand wall 0.27 m ahead-right, the left-hand wall's echoes more numerous, the guard turned right);
+    when that turn would swing the rear into what lies alongside, it sidesteps away from them instead of
+    backing off (a corridor walked a few degrees off its axis: backing off and walking on met the same wall
+    again and again, corridor_narrow seeds 18 and 19)."""
     crowd = sum(1 if by > 0 else -1 for bx, by, _s, _a in points if abs(bx) < 0.4 and abs(by) < 0.4)
+    if cmd in (FORWARD, BACKWARD):
+        crowd = sum(1 if p[1] > 0 else -1 for p in points if closing_in([p], cmd, t) > 0) or crowd
     freer = (RIGHT, LEFT) if crowd > 0 else (LEFT, RIGHT)
     away = SIDE_RIGHT if crowd > 0 else SIDE_LEFT
-    options = {FORWARD: (*freer, BACKWARD), BACKWARD: freer, LEFT: (RIGHT, BACKWARD, FORWARD),
+    options = {FORWARD: (freer[0], away, freer[1], BACKWARD) if crowd else (*freer, BACKWARD), BACKWARD: freer,
+               LEFT: (RIGHT, BACKWARD, FORWARD),
                RIGHT: (LEFT, BACKWARD, FORWARD), SIDE_LEFT: (SIDE_RIGHT, *freer), SIDE_RIGHT: (SIDE_LEFT, *freer)}
     if crowd and cmd == freer[0]:                     # the other way is towards the crowded side
         options[cmd] = (away, *options[cmd])

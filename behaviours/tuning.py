@@ -185,8 +185,11 @@ NP3_WALL_LOST_S = 8.0         # ... no wall beside for this long: turn right to 
 # --- SPU (seed 3.2.5): polling order, status checks, alarms and forwarding rate limits to the NP3 (all CHOICE)
 SPU_CYCLE = ("IRRC", "USRC", "IRRC", "LSC", "IRRC", "USRC", "IRRC", "ISC",   # IR every 2nd poll (5.2), the
              "IRRC", "USRC", "IRRC", "TSC", "IRRC", "USRC", "IRRC", "PSC")   # sonar every 4th: one angle of its scan
-SPU_SCAN_AHEAD_DEG = (0, 15, 30, 15, 0, -15, -30, -15)   # the sonar scan the SPU drives (HEAD_SET_ABS + DO_MEASURE,
-                              # 3.2.11; issue 17): a sweep ahead of the heading, where the robot walks and turns ...
+SPU_SCAN_AHEAD_DEG = (0, 15, -30, -15, 0, 15, 30, -15)   # the sonar scan the SPU drives (HEAD_SET_ABS + DO_MEASURE,
+                              # 3.2.11; issue 17): a sweep ahead of the heading, where the robot walks and turns, the
+                              # sides in turn: each +-15 deg angle every 4th (a back-and-forth sweep brought one side's
+                              # twice in a row, then none for 3.6 s: a cone point of a corridor's wall stayed in the
+                              # way uncleared, corridor_narrow seeds 2, 5, 7, 9) ...
 SPU_SCAN_ROUND_EVERY = 3      # ... and every 3rd angle one of the rest of the circle, for the map (3.3.2) ...
 SPU_SCAN_ROUND_STEP_DEG = 15  # ... in steps of the beam's width, round from the sweep's edge ...
 SPU_SCAN_SIDE_DEG = (90, -90, 75, -75, 105, -105)   # ... but mostly the sides, left and right in turn, where a

@@ -402,6 +402,37 @@ def test_the_motion_check_refuses_only_moves_that_close_in_on_an_echo():
     assert safe_instead(flank, MovCmd.TURN_RIGHT, t) == MovCmd.SIDESTEP_RIGHT
 
 
+def test_a_refused_walk_turns_away_from_what_it_would_close_in_on():
+    """corridor_narrow seed 3: walking 10 deg off a corridor's axis, the right-hand wall's echo 0.27 m ahead-right
+    refused FORWARD; the left-hand wall alongside had more echoes near the body, and turning towards the freer
+    side by their count turned the robot right, into the wall ahead."""
+    from behaviours.np3_layers import closing_in, safe_instead
+    t = Tuning()
+    ahead_right = (0.272, -0.084, -11.0, 0.085)
+    left_wall = [(x / 10, 0.27, 90.0, 0.0) for x in range(-3, 4)]        # alongside, out of the way
+    pts = [ahead_right, *left_wall]
+    assert closing_in(pts, MovCmd.FORWARD, t) > 0 and closing_in(left_wall, MovCmd.FORWARD, t) == 0
+    assert safe_instead(pts, MovCmd.FORWARD, t) == MovCmd.TURN_LEFT
+    mirrored = [(bx, -by, -s, a) for bx, by, s, a in pts]
+    assert safe_instead(mirrored, MovCmd.FORWARD, t) == MovCmd.TURN_RIGHT
+
+
+def test_a_refused_walk_sidesteps_off_a_wall_alongside_when_turning_would_swing_into_it():
+    """corridor_narrow seeds 18, 19: a few degrees off the corridor's axis, the right-hand wall 9 cm off the right
+    flank and its echo 0.25 m ahead-right refuse FORWARD; either turn swings an end of the body into the wall,
+    and backing off and walking on met the same wall again and again. The guard steps away from it instead."""
+    from behaviours.np3_layers import closing_in, safe_instead
+    t = Tuning()
+    right_wall = [(x / 20, -0.17, -90.0, 0.0) for x in range(-4, 3)]
+    left_wall = [(x / 20, 0.30, 90.0, 0.0) for x in range(-4, 5)]
+    pts = [(0.25, -0.112, -15.0, 0.056), *right_wall, *left_wall]
+    assert closing_in(pts, MovCmd.FORWARD, t) > 0
+    assert closing_in(pts, MovCmd.TURN_LEFT, t) > 0 and closing_in(pts, MovCmd.TURN_RIGHT, t) > 0
+    assert safe_instead(pts, MovCmd.FORWARD, t) == MovCmd.SIDESTEP_LEFT
+    mirrored = [(bx, -by, -s, a) for bx, by, s, a in pts]
+    assert safe_instead(mirrored, MovCmd.FORWARD, t) == MovCmd.SIDESTEP_RIGHT
+
+
 def test_a_refused_command_hands_the_actuator_to_the_guard_reflex(spec):
     rig = np3(spec)
     rig.run(1.0)

@@ -121,6 +121,23 @@ def test_the_sonar_scan_stays_ahead_while_something_straight_ahead_is_near():
     assert not set(scan.next() for _ in range(T.SPU_SCAN_ROUND_EVERY)) <= sweep
 
 
+def test_the_sonar_scan_brings_each_angle_of_the_sweep_round_evenly():
+    """issue 17 (corridor_narrow seeds 2, 5, 7, 9): a back-and-forth sweep pinged one side's 15 deg angle twice in
+    a row and then not for 3.6 s; a cone point of a corridor's wall 0.55 m ahead, which only that angle clears,
+    came within the motion check's reach first and the guard turned the robot in the corridor. With something
+    near ahead (the sweep alone), each angle of it recurs at a fixed interval: the sides in turn."""
+    scan = SonarScan()
+    scan.heard(0, T.SPU_SCAN_NEAR_M / 2)
+    angles = [scan.next() for _ in range(4 * len(T.SPU_SCAN_AHEAD_DEG))]
+    for a in set(angles):
+        hits = [k for k, b in enumerate(angles) if b == a]
+        gaps = {b - a for a, b in zip(hits, hits[1:])}
+        assert len(gaps) == 1, (a, gaps)
+    for side in (15, -15):
+        hits = [k for k, b in enumerate(angles) if b == side % 360]
+        assert max(b - a for a, b in zip(hits, hits[1:])) <= len(T.SPU_SCAN_AHEAD_DEG) // 2
+
+
 def test_the_sonar_scan_sweeps_ahead_and_steps_round_the_circle(spec):
     """seed 3.2.11, issue 17: HEAD_SET_ABS, DO_MEASURE, XMIT_DATA per angle; most angles ahead of the heading."""
     rig, _ = spu(spec, until=8.0)
