@@ -35,8 +35,8 @@ from arachnae_proto.skeletons.np3 import Np3Skeleton
 from behaviours import tuning as T
 from behaviours.gait import FIVE_LEGGED, STILL, Gait
 from behaviours.geometry import RobotGeometry
-from behaviours.np3_layers import (AVOIDANCE, REFLEXES, TaskModule, Tuning, body_frame, closing_in, np3_network,
-                                   safe_instead, steepness_deg, uphill)
+from behaviours.np3_layers import (AVOIDANCE, REFLEXES, PinnedCheck, TaskModule, Tuning, body_frame, closing_in,
+                                   np3_network, safe_instead, steepness_deg, uphill)
 from behaviours.runtime import Runtime
 from behaviours.topomap import (OCCUPIED, FrontierTarget, HeadingVotes, OccupancyGrid, Reading, TopoMap, heading_offset,
                                 ray_cells)
@@ -333,7 +333,8 @@ class NP3(Runtime, Np3Skeleton):
         self.heard: set[str] = set()          # roles that sent a record since power-on
         self.look_until = math.inf            # no step before the IR and whiskers reported, or until then (seed 5.2)
         self.tilt = [0.0, 0.0]
-        self.seq = {"whisker": 0, "pit": 0, "leg_blocked": 0, "light": 0, "sound": 0, "veto": 0}
+        self.seq = {"whisker": 0, "pit": 0, "leg_blocked": 0, "light": 0, "sound": 0, "veto": 0, "pinned": 0}
+        self.pinned = PinnedCheck(self.tuning)        # issue 17: the body held by something no sensor sees
         self.escape_plans: dict[str, Any] = {}   # module -> its manoeuvre last noted as an escape window (5.2)
         self.mmc_error = (0, 0)
         self.battery_low = False
@@ -571,6 +572,7 @@ class NP3(Runtime, Np3Skeleton):
         self.sent = (mov, self.sent_module)
         self.moves_sent += 1
         self.odo.command(self.now, mov)
+        self.pinned.command(self.now, mov)
         self.send(src, M.Move(mov_cmd=mov, param=0))
 
     # --- sensing: DATA records only ----------------------------------------------------------------
@@ -635,6 +637,7 @@ class NP3(Runtime, Np3Skeleton):
         reckoning walks it too (no motion counted that the legs did not make), and the network's next command
         goes out even if it equals what we sent last."""
         self.odo.command(self.now, cmd)
+        self.pinned.command(self.now, cmd)
         self.sent = (cmd, "reflex")
 
     def bump(self, register: str, *data: Any) -> None:
@@ -714,6 +717,9 @@ class NP3(Runtime, Np3Skeleton):
         rel = (head_deg + 180) % 360 - 180
         if abs(rel) <= T.NP3_SONAR_AHEAD_DEG and d is not None:
             self.sonar_ahead = (pinged_at, d)
+        if self.pinned.heard(rel, d, pinged_at, (x, y),
+                             self.pinned.alongside(body_frame(tuple(e.point() for e in self.echoes), self.odo.pose))):
+            self.bump("pinned")
         self.sonar_memory(Ping(self.now, x, y, th + math.radians(rel), _Q["USRC"].phys(_Q["USRC"].hi) if d is None
                                else d), rel)
         half, n = T.NP3_SONAR_BEAM_DEG / 2, 5

@@ -49,13 +49,14 @@ Trigger = Callable[[Mapping[str, Any], float], "Steps | None"]
 #   veto (seq, command)          the node's motion check refused the command the network chose: do this instead
 #   mapped ((x, y, 0, arc_m), ...) occupied cells of the topological map round the DR pose (3.3.2): what the
 #                                echo memory has let go of (a block walked along for longer than it keeps echoes)
+#   pinned int                   count of PinnedCheck's findings: the body held by something no sensor sees
 _BRIGHTNESS = next(f.conv for f in XmitDataLsc.FIELDS if f.name == "brightness")
 # seed 3.2.16: one step of the LSC's logarithmic brightness code in log10 lux (1/64 decade), from the spec
 LSC_STEP_LOG = math.log10(_BRIGHTNESS.to_phys(_BRIGHTNESS.hi) / _BRIGHTNESS.to_phys(_BRIGHTNESS.lo)) \
     / (_BRIGHTNESS.hi - _BRIGHTNESS.lo)
 
 SENSORS = ("whisker", "ir", "ir_fault", "pit", "tilt", "battery_low", "leg_blocked", "sonar_ahead_m", "light",
-           "pose", "goal", "sound", "echoes", "veto", "mapped")
+           "pose", "goal", "sound", "echoes", "veto", "mapped", "pinned")
 
 
 _IRRC = quantizer(XMIT_DATA_OF["IRRC"], "center")
@@ -121,6 +122,13 @@ class Tuning:
     guard_margin_m: float = T.NP3_GUARD_MARGIN_M
     guard_horizon_s: float = T.NP3_GUARD_HORIZON_S
     guard_hold_s: float = T.NP3_GUARD_HOLD_S
+    pinned_progress_m: float = T.NP3_PINNED_PROGRESS_M
+    pinned_change: float = T.NP3_PINNED_CHANGE
+    pinned_angles: int = T.NP3_PINNED_ANGLES
+    pinned_range_m: tuple[float, float] = T.NP3_PINNED_RANGE_M
+    pinned_window_s: float = T.NP3_PINNED_WINDOW_S
+    pinned_beside_m: float = T.NP3_PINNED_BESIDE_M
+    pinned_ref_s: float = T.NP3_PINNED_REF_S
 
 
 def _seen(ir: Any) -> list[float | None]:
@@ -447,6 +455,95 @@ def safe_instead(points: list[Point], cmd: Any, t: Tuning) -> Any:
     return STOP
 
 
+class SonarFix(NamedTuple):
+    """One sonar range at one scan angle, with where the dead reckoning had the body when it was pinged."""
+
+    t: float
+    metres: float
+    x: float
+    y: float
+
+
+class PinnedCheck:
+    """seed 5.1.2, issue 17: the body pressed against something no sensor sees. A post lower than the sonar
+    head and thinner than the gap between the IR fan (+-15 deg from the nose: 2.6 cm either side of the axis at
+    its 10 cm reach) and the whiskers (from the body's corners, 8 cm out, angled outward) meets the body's front
+    unseen; the legs then walk on the spot and the dead reckoning walks on (scenarios/posts_low.yaml: 30 s
+    pinned, 150-200 contacts). The sonar still hears the walls: walking forward, a range at a fixed scan
+    angle changes with the body's progress unless the surface lies along the way. Pinned when, while FORWARD is
+    walked (no step back or aside, no stop), pinned_angles angles on both sides of the axis each changed by less than
+    pinned_change of the reckoned progress (at least pinned_progress_m) since a ping at that angle at most
+    pinned_ref_s before, each comparison counting for pinned_window_s.
+    Parallel walls leave the ranges unchanged too: remembered echoes beside the body say so (`alongside`),
+    and then nothing is concluded."""
+
+    def __init__(self, t: Tuning) -> None:
+        self.t = t
+        self.since: float | None = None                  # FORWARD walked without a break since
+        self.fixes: dict[int, list[SonarFix]] = {}       # scan angle -> its pings since then
+        self.still: dict[int, tuple[float, bool]] = {}   # scan angle -> (when, range unchanged) of its last comparison
+
+    def command(self, now: float, cmd: Any) -> None:
+        """The command the legs walk from now on (sent, or a reflex's at the MCP). A turn on the spot, the task's
+        steering between two steps, is no break (the body does not move; a range at a fixed scan angle then
+        changes with the heading, which only ever says "moved"); nor is a gait change."""
+        if cmd in (LEFT, RIGHT) or cmd >= MovCmd.TRIPOD:
+            return
+        if cmd != FORWARD:
+            self.since = None
+            self.fixes.clear()
+            self.still.clear()
+        elif self.since is None:
+            self.since = now
+
+    def alongside(self, points: list[Point]) -> bool:
+        """A remembered echo (body frame) beside the body: a wall along the way keeps the ranges as they were."""
+        return any(abs(bx) <= self.t.body_half_length_m + self.t.pinned_beside_m and abs(by) <= self.t.pinned_beside_m
+                   and abs(by) > self.t.body_half_width_m for bx, by, _s, _a in points)
+
+    def heard(self, rel_deg: int, metres: float | None, fix_at: float, xy: tuple[float, float],
+              alongside: bool) -> bool:
+        """A sonar range at body angle rel_deg pinged at fix_at, the body reckoned at xy then: pinned now?
+        `alongside`: what alongside() says of the remembered echoes now."""
+        lo, hi = self.t.pinned_range_m
+        if self.since is None or fix_at < self.since or metres is None or not lo <= metres <= hi:
+            return False
+        fix = SonarFix(fix_at, metres, *xy)
+        past = [f for f in self.fixes.get(rel_deg, []) if fix_at - f.t <= self.t.pinned_ref_s]
+        self.fixes[rel_deg] = past
+        far = [f for f in past if math.hypot(fix.x - f.x, fix.y - f.y) >= self.t.pinned_progress_m]
+        if far:
+            ref = far[-1]
+            progress = math.hypot(fix.x - ref.x, fix.y - ref.y)
+            self.still[rel_deg] = (fix_at, abs(fix.metres - ref.metres) < self.t.pinned_change * progress)
+            past[:] = past[len(far) - 1:]
+        past.append(fix)
+        recent = {a: s for a, (when, s) in self.still.items() if fix_at - when <= self.t.pinned_window_s}
+        pinned = (len(recent) >= self.t.pinned_angles and all(recent.values()) and not alongside
+                  and any(a > 0 for a in recent) and any(a < 0 for a in recent))
+        if pinned:
+            self.since = fix_at
+            self.fixes.clear()
+            self.still.clear()
+        return pinned
+
+
+def pinned_trigger(t: Tuning) -> Trigger:
+    """Issue 17, seed 5.1.2: the body is pinned against something ahead no sensor sees (PinnedCheck) -> as for a
+    touch ahead whose side is not known: back off, then turn until the front is behind the side, to the side
+    the remembered echoes show clearer."""
+    edge = _Edge()
+
+    def trigger(i: Mapping[str, Any], now: float) -> Steps | None:
+        if not edge.new(i.get("pinned")):
+            return None
+        pose = i.get("pose")
+        pts = body_frame(i.get("echoes"), pose) if pose is not None else []
+        prefer = 1.0 if freer_turn(pts, t) == LEFT else -1.0
+        return contact_steps([Surface(0.0, t.body_half_length_m)], prefer, t)
+    return trigger
+
+
 # --------------------------------------------------------------------------- level 1: avoidance
 def blocking_surface(points: list[Point], t: Tuning) -> Surface | None:
     """The surface the remembered echoes in the legs' way (clear_ahead's corridor, up to avoid_echo_m from the
@@ -461,6 +558,18 @@ def blocking_surface(points: list[Point], t: Tuning) -> Surface | None:
     if all(math.hypot(px - mx, py - my) < 0.01 for px, py in way):
         return Surface(math.atan2(my, mx), math.hypot(mx, my))
     return _line(way)
+
+
+def freer_turn(pts: list[Point], t: Tuning) -> Any:
+    """The turn (LEFT or RIGHT) after which the remembered echoes leave the legs' way clearer (one avoidance
+    turn's worth); on a tie, the side with less in front of it."""
+    turn_rad = math.radians(t.turn_rate_deg_s * t.avoid_turn_s)
+    ahead = {c: clear_ahead(rotated(pts, sign * turn_rad), t.avoid_half_width_m, t.body_half_length_m)
+             for c, sign in ((LEFT, 1.0), (RIGHT, -1.0))}
+    if ahead[LEFT] != ahead[RIGHT]:
+        return LEFT if ahead[LEFT] > ahead[RIGHT] else RIGHT
+    crowd = [by for bx, by, _s, _a in pts if 0 < bx < 2 * t.avoid_echo_m and abs(by) < 3 * t.avoid_half_width_m]
+    return RIGHT if sum(1 if by > 0 else -1 for by in crowd) > 0 else LEFT
 
 
 def avoid_trigger(t: Tuning) -> Trigger:
@@ -493,15 +602,8 @@ def avoid_trigger(t: Tuning) -> Trigger:
             turn = RIGHT if surface.normal_rad > 0 else LEFT      # away from the side the surface faces it from
         elif last and now - last[0][0] <= t.avoid_turn_s + t.avoid_keep_side_s:
             turn = last[0][1]                  # still avoiding: on round the same way
-        else:                                  # the side whose heading after the turn the memory shows clearer
-            turn_rad = math.radians(t.turn_rate_deg_s * t.avoid_turn_s)
-            ahead = {c: clear_ahead(rotated(pts, sign * turn_rad), t.avoid_half_width_m, t.body_half_length_m)
-                     for c, sign in ((LEFT, 1.0), (RIGHT, -1.0))}
-            if ahead[LEFT] != ahead[RIGHT]:
-                turn = LEFT if ahead[LEFT] > ahead[RIGHT] else RIGHT
-            else:                              # the side with less in front of it
-                crowd = [by for bx, by, _s, _a in pts if 0 < bx < 2 * t.avoid_echo_m and abs(by) < 3 * t.avoid_half_width_m]
-                turn = RIGHT if sum(1 if by > 0 else -1 for by in crowd) > 0 else LEFT
+        else:
+            turn = freer_turn(pts, t)
         last[:] = [(now, turn)]
         return [(t.avoid_turn_s, turn)]
     return trigger
@@ -824,6 +926,7 @@ def np3_network(clock: Clock, task: str = "forward", tuning: Tuning | None = Non
         ReflexModule("leg_blocked", REFLEXES, ("leg_blocked",), leg_blocked_trigger(t)),   # seed 6.1
         ReflexModule("contact", REFLEXES, ("whisker", "ir", "pose", "echoes"),
                      contact_trigger(t)),                                                  # seed 3.2.12, 3.2.13, 5.2
+        ReflexModule("pinned", REFLEXES, ("pinned", "pose", "echoes"), pinned_trigger(t)),  # seed 5.1.2, issue 17
         ReflexModule("pit", REFLEXES, ("pit",), pit_trigger(t)),                           # seed 1.2.2
         ReflexModule("tilt", REFLEXES, ("tilt",), tilt_trigger(t)),                        # seed 3.2.14
         ReflexModule("ir_fault", REFLEXES, ("ir_fault",), stop_while("ir_fault")),        # seed 6.2: IR -> stop
@@ -848,5 +951,5 @@ def np3_network(clock: Clock, task: str = "forward", tuning: Tuning | None = Non
 
 
 __all__ = ["uphill", "steepness_deg", "Tuning", "TaskModule", "OrientModule", "np3_network", "light_gradient", "heading_error", "SENSORS",
-           "closing_in", "safe_instead", "body_frame",
+           "closing_in", "safe_instead", "body_frame", "PinnedCheck",
            "REFLEXES", "AVOIDANCE", "TASK", "TASKS"]

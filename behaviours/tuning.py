@@ -103,6 +103,15 @@ NP3_AVOID_HALF_WIDTH_M = 0.16 # ... within this of the body axis (body 0.08 m, t
 NP3_GUARD_MARGIN_M = 0.04    # motion check (5.1.2): no command may bring the body outline closer than this ...
 NP3_GUARD_HORIZON_S = 1.0     # ... to a remembered echo within this long (the gait takes a half cycle to stop);
 NP3_GUARD_HOLD_S = 0.3        # ... a refused command is replaced by a safe one this long
+NP3_PINNED_PROGRESS_M = 0.2   # pinned body (issue 17): over this much forward walking (dead reckoning) ...
+NP3_PINNED_CHANGE = 0.25      # ... a sonar range that changed by less than this share of it shows no motion along
+                              # its beam (noise 2 cm: a difference has 2.8 cm sigma; a range ahead changes by all 0.2 m) ...
+NP3_PINNED_ANGLES = 3         # ... and with this many scan angles, on both sides of the axis, all showing none
+NP3_PINNED_RANGE_M = (0.3, 8.0)   # ... (readings within this range only: the sonar's blind zone and no echo say nothing)
+NP3_PINNED_WINDOW_S = 4.0     # ... each angle's last comparison counting this long (the sweep's 0 and +-15 deg come
+                              # round every 3.6 s): the body is held now, not at some time before
+NP3_PINNED_REF_S = 8.0        # ... against a ping at that angle at most this old (the heading has drifted since)
+NP3_PINNED_BESIDE_M = 0.6     # ... not while a remembered echo lies beside the body within this (walls along the way)
 NP3_SOUND_MIN_DEG = 10        # sound straight ahead within this: no turn needed
 NP3_EXPLORE_PLAN_S = 10.0     # explore: a new goal every 10 s (5.2: navigation 10..30 s) or when reached:
 NP3_EXPLORE_HEADINGS = 16     # ... the best of this many headings round the robot, scored on the map by
