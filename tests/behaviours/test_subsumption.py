@@ -199,7 +199,7 @@ def test_wiring_table_lists_every_declared_connection():
     assert lines[0].split() == ["kind", "from", "to", "hold", "s"]
     assert any(l.split()[:3] == ["wire", "task.move", "actuator.move"] for l in lines)
     assert any(l.split() == ["suppress", "avoid.move", "actuator.move", "0.3"] for l in lines)
-    assert sum(1 for l in lines if l.startswith("suppress")) == 2 + 7   # orient, avoidance + seven reflexes (guard)
+    assert sum(1 for l in lines if l.startswith("suppress")) == 2 + 8   # orient, avoidance + eight reflexes (guard, pinned)
     assert len(lines) == 2 + len(net.wires) + len(net.nodes)
 
 
