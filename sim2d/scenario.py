@@ -323,6 +323,11 @@ def _check_meaning(doc: LDict, spec: Any) -> None:
                                     "list its corners in order around it")
         if abs(signed_area(corners)) < 1e-9:
             raise locate(doc, path, f"{what}: polygon has no area")
+    for i, wall in enumerate(doc.get("walls", [])):
+        for j in range(len(wall) - 1):
+            if tuple(wall[j]) == tuple(wall[j + 1]):       # a typo: a wall of no length blocks nothing
+                raise locate(doc, ["walls", i, j + 1], f"walls[{i}][{j + 1}]: point repeats the one before; "
+                                                       "a wall segment needs a length")
     for path, (x, y) in _points(doc):
         if not (0 <= x <= w and 0 <= y <= h):
             raise locate(doc, path, f"{field_name(path)}: point ({x}, {y}) lies outside the arena {w} x {h} m")

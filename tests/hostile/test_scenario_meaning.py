@@ -30,6 +30,7 @@ CASES = [
     ("obstacle outside the arena", "obstacles: [{polygon: [[3, 1], [5, 1], [5, 2]], height: 0.2}]\n", 4,
      "point (5, 1) lies outside the arena"),
     ("wall outside the arena", "walls: [[[3, 1], [3, -1]]]\n", 4, "walls[0][1]: point (3, -1) lies outside"),
+    ("wall of no length", "walls:\n  - [[3, 1], [3, 2]]\n  - [[2, 1], [2, 1]]\n", 6, "walls[1][1]: point repeats the one before"),
     ("light outside the arena", "lights: [{pos: [9, 9], intensity: 10}]\n", 4, "lights[0].pos: point (9, 9)"),
     ("reach region outside", "expect: {reach: {region: [[3, 1], [9, 1], [9, 2]], within: 5}}\n", 4, "lies outside"),
     ("fault after the end", "faults: [{at: 30, kill: PSC}]\n", 4, "30 s is not before the end of the run"),
