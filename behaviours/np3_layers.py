@@ -468,11 +468,11 @@ class PinnedCheck:
     """seed 5.1.2, issue 17: the body pressed against something no sensor sees. A post lower than the sonar
     head and thinner than the gap between the IR fan (+-15 deg from the nose: 2.6 cm either side of the axis at
     its 10 cm reach) and the whiskers (from the body's corners, 8 cm out, angled outward) meets the body's front
-    unseen; the legs then walk on the spot and the dead reckoning walks on (scenarios/posts_low.yaml: 30 s
-    pinned, 150-200 contacts). The sonar still hears the walls: walking forward, a range at a fixed scan
-    angle changes with the body's progress unless the surface lies along the way. Pinned when, while FORWARD is
-    walked (no step back or aside, no stop), pinned_angles angles on both sides of the axis each changed by less than
-    pinned_change of the reckoned progress (at least pinned_progress_m) since a ping at that angle at most
+    unseen; the legs then walk on the spot and the dead reckoning walks on (scenarios/posts_low.yaml without
+    this check: held for the whole run, 220 contacts). The sonar still hears the walls: walking forward, a range at a fixed scan
+    angle changes with the body's progress unless the surface lies along the way. Pinned when, while FORWARD
+    is walked (no step back or aside, no stop), pinned_angles angles on both sides of the axis each changed by
+    less than pinned_change of the reckoned progress (at least pinned_progress_m) since a ping at that angle at most
     pinned_ref_s before, each comparison counting for pinned_window_s.
     Parallel walls leave the ranges unchanged too: remembered echoes beside the body say so (`alongside`),
     and then nothing is concluded."""
@@ -516,7 +516,7 @@ class PinnedCheck:
             ref = far[-1]
             progress = math.hypot(fix.x - ref.x, fix.y - ref.y)
             self.still[rel_deg] = (fix_at, abs(fix.metres - ref.metres) < self.t.pinned_change * progress)
-            past[:] = past[len(far) - 1:]
+            past[:] = past[past.index(ref):]          # older ones are further back still
         past.append(fix)
         recent = {a: s for a, (when, s) in self.still.items() if fix_at - when <= self.t.pinned_window_s}
         pinned = (len(recent) >= self.t.pinned_angles and all(recent.values()) and not alongside
