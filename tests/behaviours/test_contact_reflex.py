@@ -11,7 +11,7 @@ from typing import NamedTuple
 
 import pytest
 
-from behaviours.np3_layers import Tuning, contact_trigger, velocity
+from behaviours.np3_layers import ContactModule, Tuning, contact_trigger, velocity
 from behaviours import tuning as T
 from sim2d.robot_params import DEFAULT as P
 
@@ -111,3 +111,43 @@ def test_switched_on_next_to_walls_the_reflex_turns_away_without_touching(name):
     for w in walls:                                     # every wall behind the robot's side: it walks away
         off = abs((math.degrees(heading) - w.normal_deg + 180.0) % 360.0 - 180.0)
         assert off >= 90.0 + T.NP3_CONTACT_CLEAR_DEG / 2, f"{name}: heading {math.degrees(heading):.0f} deg, wall {w}"
+
+
+def test_a_touch_the_ir_reports_a_poll_later_is_escaped_from_what_the_beams_see():
+    """The TPSC reports at once, the IRRC when polled: the right whisker's touch of a block nearly square ahead
+    arrives while the beams still read nothing (clutter seed 3). The guess (the surface 60 deg aside) turns
+    only 50 deg without backing off and leaves the face ahead of the robot's side; once the beams report
+    (0.2 s later) the escape is planned again from them: back off, turn until the face is behind the side."""
+    walls = walls_at((-10.0,), 0.07)
+    seen = sensed(walls)
+    assert seen["whisker"][1:3] == (False, True) and seen["ir"][1] is not None     # the case: right whisker, IR ahead
+    blind = {**seen, "ir": (None, None, None)}
+    guess = contact_trigger(TUNING)(blind, 0.0)
+    _worst, heading = follow(guess, walls)
+    off = abs((math.degrees(heading) - walls[0].normal_deg + 180.0) % 360.0 - 180.0)
+    assert off < 90.0 + T.NP3_CONTACT_CLEAR_DEG / 2           # the guess alone: the face still ahead of the side
+    reflex = ContactModule(TUNING)
+    first = reflex.step(blind, 0.0)["move"]
+    assert first is not None
+    later = 0.2
+    reflex.step(seen, later)
+    steps = [(later, first), *reflex.plan.steps]
+    worst, heading = follow(steps, walls)
+    assert worst < 0.0, f"a body corner went {worst:.3f} m into the wall"
+    off = abs((math.degrees(heading) - walls[0].normal_deg + 180.0) % 360.0 - 180.0)
+    assert off >= 90.0 + T.NP3_CONTACT_CLEAR_DEG / 2, f"heading {math.degrees(heading):.0f} deg: walks back into it"
+    reflex.step(seen, later + 0.1)                             # re-planned once: the IR seeing it again changes nothing
+    assert reflex.plan.steps == steps[1:]
+
+
+def test_a_touch_the_ir_reports_after_the_hold_keeps_its_escape():
+    """Only the beams' report of the touch itself re-plans: an echo more than one reflex hold later is
+    something the escape has turned to since, and the escape runs on."""
+    walls = walls_at((-10.0,), 0.07)
+    seen = sensed(walls)
+    blind = {**seen, "ir": (None, None, None)}
+    reflex = ContactModule(TUNING)
+    reflex.step(blind, 0.0)
+    plan = reflex.plan
+    reflex.step(seen, TUNING.reflex_hold_s + 0.1)
+    assert reflex.plan is plan
