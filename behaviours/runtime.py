@@ -257,6 +257,10 @@ class Runtime:
         if link is not None and link.current is not None and sent == link.frame:
             req, serial = link.current, link.current.serial
             if heard != sent:                      # seed 3.2.2: corrupt echo -> send again
+                # off the wire again while it waits out the slaves' window: a reflex fetch queued meanwhile goes
+                # first (spec reflexes, seed 5.2; worst_contention seed 1: a PSC poll that collided kept the
+                # whisker's fetch waiting through two resend waits, the LSC past K)
+                req.sent = False
                 self.hw.after(self._master_resend_wait(link), self._transmit, link, serial)
             elif not req.expect:
                 link.current = None

@@ -79,6 +79,7 @@ class Rig:
         self.board = Board()
         self.respond = respond or (lambda f: [])
         self.sent: list[tuple[float, str, Frame]] = []
+        self.garble: Callable[[Frame], bool] = lambda f: False   # True: that frame collides (corrupt echo, no reply)
         cfg = Config(NetConfig.from_spec(spec), DEFAULT_GEOMETRY, task)
         self.node = behaviour_class(role)(address, self._transmit, self.board, cfg)
         self.node.start()
@@ -89,6 +90,9 @@ class Rig:
         self.sent.append((b.t, bus, frame))
         end = max(b.t, b.busy_until.get(bus, 0.0)) + len(data) * t.char_s
         b.busy_until[bus] = end
+        if self.garble(frame):
+            b.after(end - b.t, self.node.on_echo, bus, data, data[:-1] + bytes([data[-1] ^ 0xFF]))
+            return
         b.after(end - b.t, self.node.on_echo, bus, data, data)
         start = end + t.turnaround_s
         for src, msg in self.respond(frame):

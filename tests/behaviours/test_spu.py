@@ -205,3 +205,30 @@ def test_a_sensor_announcing_again_before_its_fetch_goes_out_is_fetched_once(spe
     assert len([1 for at, _f in rig.frames(M.XmitData, A["USRC"]) if at >= t]) == 1
     assert rig.node.debug_metrics()["coalesced"] == 2
 
+
+
+def test_a_whisker_fetch_goes_ahead_of_a_poll_waiting_to_resend_after_a_collision(spec):
+    """spec reflexes (seed 5.2): a poll whose frame collided is off the wire while it waits out the slaves' window;
+    the whisker's fetch queued meanwhile goes first (worst_contention seed 1: it waited two resend windows behind
+    a PSC poll, and the LSC past K)."""
+    rig, _ = spu(spec)
+    t = rig.board.t
+    hits: list[float] = []
+
+    def first_psc_poll(f) -> bool:
+        if f.dst == A["PSC"] and isinstance(f.message, M.XmitData) and not hits:
+            hits.append(rig.board.t)
+            return True
+        return False
+
+    rig.garble = first_psc_poll
+    rig.node.request(A["PSC"], M.XmitData(), (M.XmitDataPsc,))
+    while not hits and rig.board.t < t + 2.0:
+        rig.run(rig.board.t + 0.005)
+    assert hits
+    rig.run(hits[0] + 0.05)                                 # the collided frame has ended: its resend waits
+    rig.inject(rig.board.t, A["TPSC"], M.DataRdy())
+    rig.run(t + 3.0)
+    tpsc = [at for at, _f in rig.frames(M.XmitData, A["TPSC"]) if at > hits[0]]
+    psc = [at for at, _f in rig.frames(M.XmitData, A["PSC"]) if at > hits[0]]
+    assert tpsc and psc and tpsc[0] < psc[0]
