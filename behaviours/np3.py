@@ -595,7 +595,7 @@ class NP3(Runtime, Np3Skeleton):
             self.stopped_by_reflex(msg.address)
             for side, hit in ((1.0, left), (-1.0, right)):   # the touch: anywhere along the whisker, so
                 for along in (0.2, 0.5, 0.85) if hit else ():     # points near its root, middle and tip
-                    self.echo(T.NP3_BODY_FRONT_M, side * self.geo.body_width / 2, side * T.NP3_WHISKER_DEG,
+                    self.echo(T.NP3_BODY_FRONT_M, side * T.NP3_WHISKER_Y_M, side * T.NP3_WHISKER_DEG,
                               along * T.NP3_WHISKER_M)
         elif role == "IRRC" and 0 <= ch < 3:                            # seed 3.2.13: beam 0 left, 1 centre, 2 right
             self.ir[ch] = None if v >= _Q["IRRC"].hi else decode(role, v) / 100

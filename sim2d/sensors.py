@@ -100,7 +100,7 @@ class Sensors:
         x, y, th = self.robot.pose
         res = []
         for side in (1.0, -1.0):
-            root = to_world(self.robot.pose, p.body_length / 2, side * p.body_width / 2)
+            root = to_world(self.robot.pose, p.body_length / 2, side * p.whisker_root_y)
             hit = self.world.ray(root, th + side * p.whisker_angle, p.whisker_length, p.whisker_height)
             if hit is not None:
                 self.log.whisker_hits.append((t, hit[1]))

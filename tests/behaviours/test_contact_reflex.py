@@ -69,7 +69,7 @@ def sensed(walls: list[Wall]) -> dict:
     front = (P.body_length / 2, 0.0)
     ir = tuple(ray(front, deg, P.ir_range, walls) for deg in P.ir_beams_deg)
     deg = math.degrees(P.whisker_angle)
-    left, right = (ray((P.body_length / 2, side * P.body_width / 2), side * deg, P.whisker_length, walls) is not None
+    left, right = (ray((P.body_length / 2, side * P.whisker_root_y), side * deg, P.whisker_length, walls) is not None
                    for side in (1.0, -1.0))
     return {"ir": ir, "whisker": (1, left, right, 0.0), "pose": (0.0, 0.0, 0.0), "echoes": sonar_echoes(walls)}
 

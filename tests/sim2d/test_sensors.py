@@ -45,9 +45,37 @@ def test_ir_beams_and_whiskers(write, spec):
     assert s.whiskers() == (True, True)
     s = sensors(write)
     assert s.irrc() == (None, None, None) and s.whiskers() == (False, False)
-    # an obstacle only on the left touches the left whisker only
-    s = sensors(write, "obstacles: [{polygon: [[1.16, 2.1], [1.3, 2.1], [1.3, 2.3], [1.16, 2.3]], height: 0.2}]\n")
-    assert s.whiskers() == (True, False)
+    # a post only on the left, in the lane between the IR fan and the body's side, touches the left whisker only
+    s = sensors(write, "obstacles: [{polygon: [[1.17, 2.04], [1.2, 2.04], [1.2, 2.07], [1.17, 2.07]], height: 0.12}]\n")
+    assert s.whiskers() == (True, False) and s.irrc() == (None, None, None)
+
+
+SEEN_AHEAD_M = 0.035     # issue 17: a whisker touch stops the legs ~0.33 s later, 3.3 cm at 10 cm/s
+
+
+@pytest.mark.parametrize("width", [0.02, 0.03])
+def test_every_thin_post_in_the_body_lane_is_sensed_before_the_body_meets_it(write, spec, width):
+    """issue 17 (scenarios/posts_low.yaml): walking straight at a post 12 cm tall (below the sonar head) of the
+    given width, wherever it overlaps the body's lane (its inner edge from 10 cm right to 8 cm left of the axis,
+    in 5 mm steps), the IR beams or a whisker touch it while its near face is still SEEN_AHEAD_M or more ahead
+    of the front face. From the body's corners, angled outward, the whiskers left 2.6-8 cm either side blind."""
+    half_w, front = P.body_width / 2, P.body_length / 2
+    blind = []
+    for k in range(int(round((2 * half_w + width) / 0.005))):
+        y0 = 2.0 - half_w - width + 0.0025 + 0.005 * k
+        x0 = 1.0 + front + 0.12
+        post = f"obstacles: [{{polygon: [[{x0}, {y0}], [{x0 + width}, {y0}], [{x0 + width}, {y0 + width}], " \
+               f"[{x0}, {y0 + width}]], height: 0.12}}]\n"
+        s = sensors(write, post)
+        seen = False
+        for step in range(int(round((0.12 - SEEN_AHEAD_M) / 0.005)) + 1):    # the body walks up to the post
+            s.robot.pose = (1.0 + 0.005 * step, 2.0, 0.0)
+            if any(s.whiskers()) or any(d is not None for d in s.irrc()):
+                seen = True
+                break
+        if not seen:
+            blind.append(round(y0 - 2.0, 4))
+    assert blind == [], f"posts with their inner edge this far left of the axis (m) are not sensed: {blind}"
 
 
 def test_light_falls_with_distance_and_is_shaded_by_walls(write, spec):
