@@ -681,3 +681,40 @@ def test_the_reckonings_turn_grip_is_the_running_gaits():
         assert bare.th > math.radians(30)
         turned[gait] = odo.th / bare.th
     assert turned == pytest.approx({g: T.NP3_DR_TURN_GRIP[g] for g in turned}, abs=1e-9)
+
+
+def _corridor(node, length_m: float, open_end: bool) -> None:
+    """The robot's map: a 2.4 m wide hall from 0.5 m behind the robot to `length_m` ahead along +x, walled, every
+    free cell passed already; its far end open onto unknown space (a frontier of 20+ cells) or walled too."""
+    g = node.map.grid
+    x, y, _ = node.odo.pose
+    for j in range(g.ny):
+        for i in range(g.nx):
+            cx, cy = g.centre(i, j)
+            dx, dy = cx - x, cy - y
+            inside = -0.5 <= dx <= length_m and abs(dy) <= 1.2
+            shell = -0.7 <= dx <= length_m + (0.0 if open_end else 0.2) and abs(dy) <= 1.4
+            if inside or shell:
+                g.logodds[j * g.nx + i] = -g.limit if inside else g.limit
+                if inside:
+                    node.visited.add((i, j))
+
+
+@pytest.mark.parametrize("open_end", [True, False], ids=["frontier_ahead", "dead_end"])
+def test_explore_routes_to_a_frontier_when_every_ray_runs_over_cells_passed_already(spec, open_end):
+    """maze_far_room seed 11: at the last corridor's top every ray ran over cells passed already (0-0.5 m not yet
+    passed); the best of them led back down the corridor for 80 s while the map showed the far room's doorway.
+    Then a route to the nearest frontier is planned; without one, the best ray after all."""
+    rig = np3(spec, task="explore")
+    rig.run(2.0)
+    node = rig.node
+    _corridor(node, 3.5, open_end)
+    node.planned_at, node.next_plan = -math.inf, 0.0
+    node.plan_goal(node.now)
+    plan = node.plans[-1]
+    assert plan.fresh_m < T.NP3_EXPLORE_FRESH_MIN_M
+    if open_end:
+        x, y, _ = node.odo.pose
+        assert plan.kind == "frontier" and plan.route[-1][0] - x >= 3.0        # to the hall's open end
+    else:
+        assert plan.kind == "heading"
