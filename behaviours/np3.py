@@ -433,8 +433,7 @@ class NP3(Runtime, Np3Skeleton):
         First choice: the heading whose ray through the map runs longest over cells not passed yet before a
         mapped obstacle, with a goal along it (short of the obstacle; not a heading the robot was just kept
         from, not_approached). When no heading is open (boxed in by
-        walls, pits, refused slopes), every ray runs over cells passed already (fresh < NP3_EXPLORE_FRESH_MIN_M)
-        or a route is being followed, a route over the topological map to the
+        walls, pits, refused slopes) or a route is being followed, a route over the topological map to the
         nearest frontier (free space bordering unknown space, at least NP3_PLAN_MIN_PATH_M away), waypoint
         by waypoint; it is planned again (the map has changed) every NP3_EXPLORE_PLAN_S.
         (Measured, issue 17: frontier routes as the first choice covered less of the explore room, 0.36-0.40
@@ -463,14 +462,6 @@ class NP3(Runtime, Np3Skeleton):
                 self.chose(now, "frontier", 0.0)
                 return
         best = self.open_heading(x, y, th)
-        if best is not None and best.fresh_m < T.NP3_EXPLORE_FRESH_MIN_M and self.cfg.task != "seek_light":
-            # CHOICE: every ray runs over cells passed already: a route to the nearest frontier, where a gap
-            # the rays miss leads on (maze_far_room seed 11: 80 s back and forth at the last corridor's top,
-            # the far room's doorway on the map); no frontier: the best ray after all (seek_light tried one)
-            self.goal = self.route_to_frontier(x, y, now)
-            if self.goal is not None:
-                self.chose(now, "frontier", best.fresh_m)
-                return
         if best is not None:
             length = min(best.free_m - T.NP3_EXPLORE_MARGIN_M, T.NP3_EXPLORE_GOAL_M)
             self.goal = (x + length * math.cos(best.heading), y + length * math.sin(best.heading))

@@ -119,7 +119,6 @@ NP3_EXPLORE_REACH_M = 3.0     # ... the cells not yet passed along the ray, up t
 NP3_EXPLORE_MARGIN_M = 0.5    # ... the goal stays this far short of the obstacle
 NP3_EXPLORE_GOAL_M = 2.0      # ... and at most this far away
 NP3_EXPLORE_SEEN_M = 0.5      # ... cells within this of the path count as passed
-NP3_EXPLORE_FRESH_MIN_M = 1.0  # ... and when the best ray has less than this not yet passed, a frontier route first
 NP3_EXPLORE_BLOCKED_M = 0.6   # a heading goal not approached while avoidance took over: that heading is not chosen
 NP3_EXPLORE_BLOCKED_DEG = 30.0  # ... again within this of where it failed, this close to it (a few kept)
 NP3_EXPLORE_BLOCKED_KEEP = 6
