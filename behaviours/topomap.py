@@ -580,7 +580,7 @@ class Stuck(NamedTuple):
     at: tuple[float, float]
 
 
-_CHOICES = 5      # FrontierTarget.route: the kept target, new ones (given up at once behind a stuck waypoint), start over
+_TRIES = 12      # FrontierTarget.route: at most this many frontiers looked at per replan (each one a map search)
 
 
 @dataclass
@@ -596,7 +596,8 @@ class FrontierTarget:
     and the next frontier is chosen. A target not approached leaves its route's next waypoint as one the
     robot could not get past: a frontier whose route leads through it (a waypoint within `exclude_m`) is
     given up at once, not after another `patience_s` (light_behind_wall seed 5, issue 17: 90 s on frontiers
-    behind the same unreachable waypoint), while the robot is within `stuck_near_m` of where it was stuck.
+    behind the same unreachable waypoint), while the robot is within `stuck_near_m` of where it was stuck;
+    those do not count among the three choices a replan has (the kept target, a new one, start over).
     When every frontier left has been given up, they count again and the waypoints are forgotten (the map
     has grown since: start over rather than stop).
     """
@@ -615,16 +616,18 @@ class FrontierTarget:
               min_path_m: float = 0.0, size_weight: float = 0.0) -> list[tuple[float, float]]:
         """The route from (x, y) to the target over `topo` (rebuilt by the caller), waypoints nearer than
         `reached_m` dropped; [] when no frontier is left to explore. The frontier arguments: TopoMap.frontier."""
-        # the kept target, else (given up) new ones (CHOICE: a few, those behind a stuck waypoint go at once),
-        # else start over
         self.stuck = [s for s in self.stuck if math.dist(s.at, (x, y)) <= self.stuck_near_m]
-        for _choice in range(_CHOICES):
+        choices = 0            # the kept target, else (given up) a new one, else start over; frontiers given up
+        for _try in range(_TRIES):     # behind a stuck waypoint do not count (the map shrinks by one each try)
+            if choices == 3:
+                break
             if self.target is None:
                 f = topo.frontier(x, y, min_size=min_size, min_path_m=min_path_m, size_weight=size_weight,
                                   exclude=self.given_up, exclude_m=self.exclude_m)
                 if f is None and self.given_up:       # all explored or given up: the map has grown since,
                     self.given_up.clear()             # so start over rather than stop
                     self.stuck.clear()
+                    choices += 1
                     continue
                 if f is None:
                     return []
@@ -635,14 +638,15 @@ class FrontierTarget:
             left = topo.length((x, y), route)
             if left < self.left_m - self.progress_m:
                 self.left_m, self.closer_at = left, now
-            patient = now - self.closer_at <= self.patience_s
-            if route and math.dist(self.target, (x, y)) > self.exclude_m and patient \
-                    and topo.frontier_near(*self.target, self.exclude_m) and not self._through_stuck(route):
+            patient, behind = now - self.closer_at <= self.patience_s, self._through_stuck(route)
+            if route and math.dist(self.target, (x, y)) > self.exclude_m and patient and not behind \
+                    and topo.frontier_near(*self.target, self.exclude_m):
                 return route
             if route and not patient:
                 self.stuck.append(Stuck(route[0], (x, y)))    # the waypoint it could not get past
             self.given_up.append(self.target)
             self.target = None
+            choices += not behind
         return []
 
     def _through_stuck(self, route: Sequence[tuple[float, float]]) -> bool:
