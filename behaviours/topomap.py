@@ -595,8 +595,8 @@ class FrontierTarget:
     approached (its route not `progress_m` shorter for `patience_s`). Then it is given up, frontier cells near it no longer count (no revisits)
     and the next frontier is chosen. A target not approached leaves its route's next waypoint as one the
     robot could not get past: a frontier whose route leads through it (a waypoint within `exclude_m`) is
-    given up at once, not after another `patience_s` (light_behind_wall seed 5, issue 17: 90 s on frontiers
-    behind the same unreachable waypoint), while the robot is within `stuck_near_m` of where it was stuck;
+    given up at once, not after another `patience_s` (light_behind_wall seed 5 on an earlier branch: 90 s on
+    frontiers behind the same unreachable waypoint), while the robot is within `stuck_near_m` of where it was stuck;
     those do not count among the three choices a replan has (the kept target, a new one, start over).
     When every frontier left has been given up, they count again and the waypoints are forgotten (the map
     has grown since: start over rather than stop).
@@ -660,5 +660,5 @@ def full_scan(x: float, y: float, heading_deg: float, ranges: Sequence[float | N
     return [Reading(x, y, heading_deg, k * step_deg, d) for k, d in enumerate(ranges)]
 
 
-__all__ = ["RayEnd", "heading_offset", "HeadingVotes", "Reading", "Place", "Frontier", "FrontierTarget", "Stuck", "OccupancyGrid", "TopoMap", "full_scan", "line_cells", "ray_cells",
-           "point_in_polygon", "UNKNOWN", "FREE", "OCCUPIED", "USRC_MAX_RANGE_M", "USRC_MIN_RANGE_M"]
+__all__ = ["RayEnd", "heading_offset", "HeadingVotes", "Reading", "Place", "Frontier", "FrontierTarget", "OccupancyGrid", "TopoMap", "full_scan", "line_cells", "ray_cells",
+           "point_in_polygon", "Stuck", "UNKNOWN", "FREE", "OCCUPIED", "USRC_MAX_RANGE_M", "USRC_MIN_RANGE_M"]

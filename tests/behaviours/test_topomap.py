@@ -7,8 +7,8 @@ import statistics
 import pytest
 from PIL import Image
 
-from behaviours.topomap import (FREE, OCCUPIED, UNKNOWN, FrontierTarget, HeadingVotes, OccupancyGrid, Reading, Stuck, TopoMap,
-                               full_scan, heading_offset)
+from behaviours.topomap import (FREE, OCCUPIED, UNKNOWN, FrontierTarget, HeadingVotes, OccupancyGrid, Reading, Stuck,
+                               TopoMap, full_scan, heading_offset)
 
 Segment = tuple[tuple[float, float], tuple[float, float]]
 
@@ -391,7 +391,7 @@ def junction_map() -> TopoMap:
 
 
 def test_frontiers_behind_a_waypoint_the_robot_could_not_get_past_are_given_up_at_once():
-    """light_behind_wall seed 5 (issue 17): the frontiers it chose one after another lay behind the same
+    """light_behind_wall seed 5 (an earlier branch): the frontiers it chose one after another lay behind the same
     unreachable waypoint, 40 s each. Once the target beyond the junction is given up (not approached), the other
     frontier beyond it goes too, and the one the other way is the target at once."""
     m = junction_map()
