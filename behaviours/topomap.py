@@ -574,6 +574,15 @@ class TopoMap:
         return out
 
 
+class Stuck(NamedTuple):
+    """FrontierTarget: a route's next waypoint the robot could not get past, and where the robot was then."""
+    waypoint: tuple[float, float]
+    at: tuple[float, float]
+
+
+_TRIES = 12      # FrontierTarget.route: at most this many frontiers looked at per replan (each one a map search)
+
+
 @dataclass
 class FrontierTarget:
     """seed 3.3.2: the frontier the robot's routes lead to, kept from one replan to the next.
@@ -584,8 +593,13 @@ class FrontierTarget:
     frontier by a wall may lie where the body cannot stand, light_behind_wall seed 4 spent 40 s 0.45 m from
     one), explored (no frontier cell left within `exclude_m`), refuted (no route leads there) or not
     approached (its route not `progress_m` shorter for `patience_s`). Then it is given up, frontier cells near it no longer count (no revisits)
-    and the next frontier is chosen. When every frontier left has been given up, they count again (the
-    map has grown since: start over rather than stop).
+    and the next frontier is chosen. A target not approached leaves its route's next waypoint as one the
+    robot could not get past: a frontier whose route leads through it (a waypoint within `exclude_m`) is
+    given up at once, not after another `patience_s` (light_behind_wall seed 5 on an earlier branch: 90 s on
+    frontiers behind the same unreachable waypoint), while the robot is within `stuck_near_m` of where it was stuck;
+    those do not count among the three choices a replan has (the kept target, a new one, start over).
+    When every frontier left has been given up, they count again and the waypoints are forgotten (the map
+    has grown since: start over rather than stop).
     """
 
     exclude_m: float
@@ -595,17 +609,25 @@ class FrontierTarget:
     left_m: float = math.inf                  # the shortest route to the target so far
     closer_at: float = 0.0                    # when that last shortened
     given_up: list[tuple[float, float]] = field(default_factory=list)
+    stuck: list[Stuck] = field(default_factory=list)   # waypoints of routes not approached, while still near
+    stuck_near_m: float = 1.0     # CHOICE: ... where it was stuck (further off, another way may lead past it)
 
     def route(self, topo: TopoMap, x: float, y: float, now: float, reached_m: float, min_size: int = 5,
               min_path_m: float = 0.0, size_weight: float = 0.0) -> list[tuple[float, float]]:
         """The route from (x, y) to the target over `topo` (rebuilt by the caller), waypoints nearer than
         `reached_m` dropped; [] when no frontier is left to explore. The frontier arguments: TopoMap.frontier."""
-        for _choice in range(3):                  # the kept target, else (given up) a new one, else start over
+        self.stuck = [s for s in self.stuck if math.dist(s.at, (x, y)) <= self.stuck_near_m]
+        choices = 0            # the kept target, else (given up) a new one, else start over; frontiers given up
+        for _try in range(_TRIES):     # behind a stuck waypoint do not count (the map shrinks by one each try)
+            if choices == 3:
+                break
             if self.target is None:
                 f = topo.frontier(x, y, min_size=min_size, min_path_m=min_path_m, size_weight=size_weight,
                                   exclude=self.given_up, exclude_m=self.exclude_m)
                 if f is None and self.given_up:       # all explored or given up: the map has grown since,
                     self.given_up.clear()             # so start over rather than stop
+                    self.stuck.clear()
+                    choices += 1
                     continue
                 if f is None:
                     return []
@@ -616,12 +638,20 @@ class FrontierTarget:
             left = topo.length((x, y), route)
             if left < self.left_m - self.progress_m:
                 self.left_m, self.closer_at = left, now
-            if route and math.dist(self.target, (x, y)) > self.exclude_m \
-                    and topo.frontier_near(*self.target, self.exclude_m) and now - self.closer_at <= self.patience_s:
+            patient, behind = now - self.closer_at <= self.patience_s, self._through_stuck(route)
+            if route and math.dist(self.target, (x, y)) > self.exclude_m and patient and not behind \
+                    and topo.frontier_near(*self.target, self.exclude_m):
                 return route
+            if route and not patient:
+                self.stuck.append(Stuck(route[0], (x, y)))    # the waypoint it could not get past
             self.given_up.append(self.target)
             self.target = None
+            choices += not behind
         return []
+
+    def _through_stuck(self, route: Sequence[tuple[float, float]]) -> bool:
+        """Whether a route leads through a waypoint the robot could not get past (within `exclude_m`)."""
+        return any(math.dist(w, s.waypoint) < self.exclude_m for w in route for s in self.stuck)
 
 
 def full_scan(x: float, y: float, heading_deg: float, ranges: Sequence[float | None],
@@ -631,4 +661,4 @@ def full_scan(x: float, y: float, heading_deg: float, ranges: Sequence[float | N
 
 
 __all__ = ["RayEnd", "heading_offset", "HeadingVotes", "Reading", "Place", "Frontier", "FrontierTarget", "OccupancyGrid", "TopoMap", "full_scan", "line_cells", "ray_cells",
-           "point_in_polygon", "UNKNOWN", "FREE", "OCCUPIED", "USRC_MAX_RANGE_M", "USRC_MIN_RANGE_M"]
+           "point_in_polygon", "Stuck", "UNKNOWN", "FREE", "OCCUPIED", "USRC_MAX_RANGE_M", "USRC_MIN_RANGE_M"]

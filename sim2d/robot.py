@@ -26,13 +26,14 @@ import pymunk
 from behaviours.kinematics import fk, ik
 from sim2d.geometry import Pt, convex_hull, inside_convex, rigid_fit, to_body, to_world
 from sim2d.robot_params import RobotParams
-from sim2d.world import BODY, OBSTACLE, WALL, World
+from sim2d.world import BODY, OBSTACLE, WALL, SolidHit, World
 
 CONTACT_EPS = 0.002   # a foot within 2 mm of the ground touches it
 DEPTH_EPS = 1e-6      # a swing foot moving this much further into a solid's footprint is blocked
 LEG_REACH = 0.45      # body centre to the farthest foot, with margin
 SLIDE_SPEED = 0.05    # m/s: a foot pushing into a face that moves slower than this (along it or down) stalls
 FACE_FRICTION = 0.5   # CHOICE: a foot slides along a face only if its move along it exceeds this x its push into it
+FACE_SKIN = 0.005     # CHOICE: a foot below a solid's top and within 5 mm inside its outline is at its face, not on top
 
 
 @dataclass
@@ -96,6 +97,16 @@ class BatteryLog:
         self.stall_steps += len(stalled)
         self.stall_run = {k: self.stall_run.get(k, 0) + 1 for k in stalled}
         self.stall_run_max = max(self.stall_run_max, max(self.stall_run.values(), default=0))
+
+
+def _top_reachable(solid: SolidHit, old_z: float) -> bool:
+    """Whether a foot in the air inside a solid's outline may stand on its top.
+
+    Only if it was above the top before this step (it came down onto it), or is deeper inside the outline than
+    FACE_SKIN (the body carried it well in: it is not at a face). A foot below the top that entered a fraction
+    of a mm sideways, the body carrying it, is at the face: it stalls there (seed 6.1) instead of counting as
+    on top after one 10 ms step that no LCP poll sees (fault_battery_and_leg lost its blocked-leg event)."""
+    return solid.depth <= 0.0 or old_z >= solid.height - CONTACT_EPS or solid.depth > FACE_SKIN
 
 
 def _ccw(pts: list[Pt]) -> list[Pt]:
@@ -221,6 +232,9 @@ class Robot:
                     self._meet_solids(leg, old, old_foot, old_world, dt)
                     # a foot in the air that met an obstacle too tall to step onto is at its face, not on it
                     under = max(old_foot[2] + CONTACT_EPS, p.step_limit)
+                    solid = self.world.solid_at(*leg.world, to_world(self.pose, *p.hip(leg.index)))
+                    if not _top_reachable(solid, old_foot[2]):
+                        under = min(under, solid.height - CONTACT_EPS)   # ... nor is one below a low bar's top
                 ground = self.world.ground_height(*leg.world, under)
                 leg.over_pit = ground is None
             leg.contact = ground is not None and leg.foot[2] <= ground + CONTACT_EPS

@@ -7,8 +7,8 @@ import statistics
 import pytest
 from PIL import Image
 
-from behaviours.topomap import (FREE, OCCUPIED, UNKNOWN, FrontierTarget, HeadingVotes, OccupancyGrid, Reading, TopoMap,
-                               full_scan, heading_offset)
+from behaviours.topomap import (FREE, OCCUPIED, UNKNOWN, FrontierTarget, HeadingVotes, OccupancyGrid, Reading, Stuck,
+                               TopoMap, full_scan, heading_offset)
 
 Segment = tuple[tuple[float, float], tuple[float, float]]
 
@@ -367,3 +367,59 @@ def test_heading_votes_correct_by_a_share_of_their_median_at_most_a_step_at_a_ti
     assert v.add(math.radians(10.0)) == 0.0                                  # counted afresh
     v.add(math.radians(10.0))
     assert math.degrees(v.add(math.radians(10.0))) == pytest.approx(2.0)     # clipped to the step
+
+
+def junction_map() -> TopoMap:
+    """A free strip west-east along y = 1 (x -1.0 .. 3.0, open to the west) into a north-south one at x = 3.0
+    (y -1.0 .. 3.0, open at both ends), lined with barriers: three frontiers, two behind the junction."""
+    g = OccupancyGrid(-2.0, -2.0, 8.0, 7.0, 0.1)
+    for k in range(81):
+        g.mark_free(-1.0 + 0.05 * k, 1.0, 0.3)
+        g.mark_free(3.0, -1.0 + 0.05 * k, 0.3)
+    for k in range(69):
+        g.mark_barrier(-0.8 + 0.05 * k, 0.6)
+        g.mark_barrier(-0.8 + 0.05 * k, 1.4)
+    for k in range(29):
+        for y0 in (-0.8, 1.4):
+            g.mark_barrier(2.6, y0 + 0.05 * k)
+            g.mark_barrier(3.4, y0 + 0.05 * k)
+    for k in range(17):
+        g.mark_barrier(3.4, 0.6 + 0.05 * k)
+    m = TopoMap(g, robot_radius_m=0.16, place_spacing_m=0.5)
+    m.rebuild()
+    return m
+
+
+def test_frontiers_behind_a_waypoint_the_robot_could_not_get_past_are_given_up_at_once():
+    """light_behind_wall seed 5 (an earlier branch): the frontiers it chose one after another lay behind the same
+    unreachable waypoint, 40 s each. Once the target beyond the junction is given up (not approached), the other
+    frontier beyond it goes too, and the one the other way is the target at once."""
+    m = junction_map()
+    ft = FrontierTarget(exclude_m=0.5, progress_m=0.3, patience_s=40.0)
+    ft.route(m, 2.0, 1.0, 0.0, reached_m=0.2, min_size=3)
+    first = ft.target
+    assert first is not None and first[0] > 2.5                                    # beyond the junction
+    route = ft.route(m, 2.0, 1.0, 41.0, reached_m=0.2, min_size=3)                # stuck before it for 41 s
+    assert ft.target is not None and ft.target[0] < -0.5 and route[-1] == ft.target   # the west end
+    assert all(p[0] < 2.0 for p in route)
+    beyond = [p for p in ft.given_up if p[0] > 2.5]
+    assert any(p[1] > 2.0 for p in beyond) and any(p[1] < 0.0 for p in beyond)    # north and south ends
+    while ft.target is not None and ft.target[0] < 2.5:                             # the west end given up too:
+        ft.given_up.append(ft.target)                                               # nothing left but what is
+        ft.target = None                                                            # behind the junction ...
+        ft.route(m, 2.0, 1.0, 50.0, reached_m=0.2, min_size=3)
+    assert ft.stuck == [] and ft.target is not None and ft.target[0] > 2.5          # ... tried again (start over)
+
+
+def test_a_waypoint_the_robot_could_not_get_past_is_forgotten_once_it_is_elsewhere():
+    """Stuck before the junction is where it was stuck: 0.2 m off, the route beyond it is not taken; 1.2 m back
+    west with the west end explored (another way may lead past it now, the map has grown), it is."""
+    m = junction_map()
+    stuck = Stuck(waypoint=(2.55, 1.05), at=(2.0, 1.0))
+    near = FrontierTarget(exclude_m=0.5, progress_m=0.3, patience_s=40.0, stuck=[stuck])
+    near.route(m, 1.8, 1.0, 0.0, reached_m=0.2, min_size=3)
+    assert near.target is not None and near.target[0] < -0.5 and near.stuck == [stuck]
+    west = [(-0.95, 1.25), (-0.95, 0.75)]                                          # the west end explored
+    away = FrontierTarget(exclude_m=0.5, progress_m=0.3, patience_s=40.0, given_up=list(west), stuck=[stuck])
+    away.route(m, 0.8, 1.0, 0.0, reached_m=0.2, min_size=3)
+    assert away.target is not None and away.target[0] > 2.5 and away.stuck == [] and away.given_up == west
