@@ -289,7 +289,7 @@ def test_frontier_target_replans_round_pits_found_on_the_way_and_ends_when_explo
 
 
 def test_a_route_out_of_a_ring_of_pits_takes_its_one_gap():
-    """pit_ring's ring (scenarios/open/pit_ring.yaml) as the feet found it: from the start at its centre
+    """pit_ring's ring (scenarios/pit_ring.yaml) as the feet found it: from the start at its centre
     the route to a point outside leaves through the 0.8 m gap on the east side, whatever side the goal is on."""
     room = box(0, 0, 6, 4)
     m = TopoMap(OccupancyGrid(-0.5, -0.5, 7.0, 5.0, 0.1), robot_radius_m=0.16, place_spacing_m=0.5)
