@@ -34,10 +34,12 @@ check: setup
 timing: setup
 	$(ARACHNAE) timing
 
-## The scenario library, seeds 1-5 each (issue 14; the 1-20 sweep is sweep-suite), every expectation must hold.
+## The scenario library, seeds 1-2 each (issue 17: CI runs seeds 1-2 of every scenario; seeds 1-5 no longer fit the
+## 20-minute budget of issue 14: 27 min 23 s idle with them, twelfth session; the 1-20 sweep is sweep-suite), every
+## expectation must hold.
 ## A passing run keeps trace.tsv and metrics.json; a failing one every output (report.html, pictures, capture).
 scenarios: setup
-	$(ARACHNAE) sim batch $(filter-out scenarios/bench_60s.yaml,$(wildcard scenarios/*.yaml)) --seeds 1-5 -j 2 --out runs/batch --outputs failed
+	$(ARACHNAE) sim batch $(filter-out scenarios/bench_60s.yaml,$(wildcard scenarios/*.yaml)) --seeds 1-2 -j 2 --out runs/batch --outputs failed
 
 ## The scenario library over seeds 1-20 on a local Dask cluster, then pass rates (issue 14; not run in CI).
 sweep-suite: setup
