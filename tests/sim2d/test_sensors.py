@@ -5,6 +5,7 @@ from dataclasses import replace
 
 import pytest
 
+from behaviours import tuning as T
 from sim2d.robot import Robot
 from sim2d.robot_params import DEFAULT as P
 from sim2d.scenario import load_scenario
@@ -108,3 +109,14 @@ def test_noise_streams_are_independent(write, spec):
     assert [a.usrc_ping(0)[0] for _ in range(20)] == [b.usrc_ping(0)[0] for _ in range(20)]
     c = sensors(write, seed=8)
     assert [a.usrc_ping(0)[0] for _ in range(50)] != [c.usrc_ping(0)[0] for _ in range(50)]
+
+
+def test_the_np3_knows_the_sensor_mounts_the_simulated_body_has():
+    """The NP3 cannot import the simulator (layers), so it keeps its own copy of the mounts (behaviours.tuning):
+    an echo from a whisker touch or an IR beam is placed where that copy says. Moving a mount in
+    sim2d.robot_params (docs/decisions.md D18) without the copy would misplace every such echo silently."""
+    assert T.NP3_BODY_FRONT_M == pytest.approx(P.body_length / 2)
+    assert T.NP3_WHISKER_Y_M == pytest.approx(P.whisker_root_y)
+    assert T.NP3_WHISKER_DEG == pytest.approx(math.degrees(P.whisker_angle))
+    assert T.NP3_WHISKER_M == pytest.approx(P.whisker_length)
+    assert sorted(P.ir_beams_deg) == pytest.approx([-T.NP3_IR_BEAM_DEG, 0.0, T.NP3_IR_BEAM_DEG])
