@@ -39,10 +39,34 @@ def codec_sources(gen: Path = GEN) -> list[Path]:
     return sorted(gen.glob("arachnae_*.c")) + sorted(gen.glob("msg_*.c")) + sorted(gen.glob("log10_*.c"))
 
 
-def build(out: Path, sources: list[Path], flags: list[str], cc: str = "gcc", gen: Path = GEN) -> Path:
-    cmd = [cc, *flags, f"-I{gen}", *map(str, sources), "-o", str(out)]
-    res = subprocess.run(cmd, capture_output=True, text=True)
+def _compile(cmd: list[str], cwd: Path | None = None) -> None:
+    res = subprocess.run(cmd, capture_output=True, text=True, cwd=cwd)
     assert res.returncode == 0, f"{' '.join(cmd)}\n{res.stderr}"
+
+
+# (cc, flags, gen) -> the codec's object files, compiled once per test session (see build)
+_CODEC_OBJECTS: dict[tuple[str, tuple[str, ...], Path], list[Path]] = {}
+
+
+def build(out: Path, sources: list[Path], flags: list[str], cc: str = "gcc", gen: Path = GEN) -> Path:
+    """cc FLAGS -Igen SOURCES -o out. CHOICE: the codec's own files (codec_sources(gen)) are compiled once per
+    (cc, flags, gen) with -c, with the same flags, and linked from then on: three sanitizer builds share them
+    (each .c is its own translation unit either way, so the warnings and the code are the same)."""
+    codec = codec_sources(gen)
+    shared = [s for s in sources if s in codec]
+    key = (cc, tuple(flags), gen)
+    if shared == codec and key in _CODEC_OBJECTS:
+        objects = _CODEC_OBJECTS[key]
+    elif shared == codec:
+        folder = out.parent / f"{out.name}.codec"
+        folder.mkdir()
+        _compile([cc, *flags, f"-I{gen}", "-c", *map(str, codec)], cwd=folder)     # one STEM.o each, in folder
+        objects = [folder / f"{s.stem}.o" for s in codec]
+        _CODEC_OBJECTS[key] = objects
+    else:
+        objects, shared = [], []
+    rest = [s for s in sources if s not in shared]
+    _compile([cc, *flags, f"-I{gen}", *map(str, objects), *map(str, rest), "-o", str(out)])
     return out
 
 
@@ -90,14 +114,20 @@ def test_hash_guard_rejects_a_stale_header(tmp_path):
     assert res.returncode != 0 and "negative" in res.stderr
 
 
-def test_dev_vectors_file_is_current():
-    assert (HERE / "dev_vectors.txt").read_text() == dev_vectors.render(), "run python tests/c/dev_vectors.py"
+@pytest.fixture(scope="module")
+def dev_text() -> str:
+    """dev_vectors.render() once for the module (~1 s each time): the same text for every build."""
+    return dev_vectors.render()
+
+
+def test_dev_vectors_file_is_current(dev_text):
+    assert (HERE / "dev_vectors.txt").read_text() == dev_text, "run python tests/c/dev_vectors.py"
 
 
 # -- vectors --------------------------------------------------------------------
-def test_dev_vectors(vectors_exe, tmp_path):
+def test_dev_vectors(vectors_exe, dev_text, tmp_path):
     path = tmp_path / "dev.txt"
-    path.write_text(dev_vectors.render())
+    path.write_text(dev_text)
     res = run(vectors_exe, str(path))
     assert res.returncode == 0, res.stdout.decode()
     assert b" 0 failed" in res.stdout
@@ -108,9 +138,9 @@ def test_shared_vectors(vectors_exe):
     assert res.returncode == 0, res.stdout.decode()[-4000:]
 
 
-def test_vector_runner_detects_mismatches(vectors_exe, tmp_path):
+def test_vector_runner_detects_mismatches(vectors_exe, dev_text, tmp_path):
     """The runner itself must fail on wrong expectations (else a green run means nothing)."""
-    text = dev_vectors.render()
+    text = dev_text
     mutants = [
         text.replace("address=2 mov_cmd=7", "address=2 mov_cmd=6"),            # decoded value
         text.replace("crc 313233343536373839 29b1", "crc 313233343536373839 29b2"),
@@ -194,14 +224,21 @@ def scaling_lines(spec, only: str | None = None) -> list[str]:
     return lines
 
 
-def test_scaling_matches_encoding_rules(vectors_exe, spec, tmp_path):
-    """Raw <-> milli helpers of every scaled field against codegen/encoding.py."""
+@pytest.fixture(scope="module")
+def scaling_file(spec, tmp_path_factory) -> Path:
+    """scaling_lines(spec) written once for the module: the same seeded vectors for every build of
+    vectors_exe (computing them from codegen/encoding.py took ~20 s a build)."""
     lines = scaling_lines(spec)
-    path = tmp_path / "scaling.txt"
-    path.write_text("\n".join(lines) + "\n")
-    res = run(vectors_exe, str(path))
-    assert res.returncode == 0, res.stdout.decode()[-4000:]
     assert len(lines) > 1000
+    path = tmp_path_factory.mktemp("scaling") / "scaling.txt"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_scaling_matches_encoding_rules(vectors_exe, scaling_file):
+    """Raw <-> milli helpers of every scaled field against codegen/encoding.py."""
+    res = run(vectors_exe, str(scaling_file))
+    assert res.returncode == 0, res.stdout.decode()[-4000:]
 
 
 def test_wide_scaling_of_another_spec(tmp_path):
