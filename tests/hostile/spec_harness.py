@@ -40,10 +40,43 @@ def replace(spec_dir: Path, file: str, old: str, new: str, count: int = 1) -> Pa
     return path
 
 
+# CHOICE: the spec commands run in this process, through the function the installed command calls
+# (arachnae/__main__.py: SystemExit(main())), with what a process would show: its exit code, its stdout, its
+# stderr (an escaping exception as a Traceback there). A fresh interpreter per call (~1 s of start-up and
+# imports, ~150 calls in tests/hostile) is what made these files a fifth of the suite. `check` keeps the real
+# command: its searches may fork, and output from another process would escape the capture.
+IN_PROCESS = {"spec", "codegen", "timing"}
+
+
+def _in_process(argv: list[str]) -> subprocess.CompletedProcess:
+    """`arachnae ARGV` as the entry point runs it, cwd REPO, stdout and stderr captured."""
+    import contextlib
+    import io
+    import traceback
+
+    from arachnae.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.chdir(REPO), contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            code = main(argv)
+        except SystemExit as exc:               # argparse; Python prints a non-integer code and exits 1
+            code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+            if not isinstance(exc.code, int) and exc.code is not None:
+                print(exc.code, file=sys.stderr)
+        except Exception:                       # noqa: BLE001 - an uncaught exception, as the interpreter shows it
+            traceback.print_exc()
+            code = 1
+    return subprocess.CompletedProcess(["arachnae", *argv], code, out.getvalue(), err.getvalue())
+
+
 def cli(*args: str | Path) -> subprocess.CompletedProcess:
-    """The installed `arachnae` command, as a user runs it."""
+    """The `arachnae` command, as a user runs it (the spec commands in process: IN_PROCESS says why)."""
+    argv = [str(a) for a in args]
+    if argv and argv[0] in IN_PROCESS:
+        return _in_process(argv)
     cmd = [str(ARACHNAE)] if ARACHNAE.exists() else [sys.executable, "-m", "arachnae"]
-    return subprocess.run(cmd + [str(a) for a in args], capture_output=True, text=True, cwd=REPO, timeout=300)
+    return subprocess.run(cmd + argv, capture_output=True, text=True, cwd=REPO, timeout=300)
 
 
 def snapshot(*roots: Path) -> dict[str, tuple[int, str]]:
