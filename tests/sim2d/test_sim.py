@@ -94,12 +94,14 @@ def test_every_node_is_its_generated_skeleton(write, spec):
         assert isinstance(sim.nodes[n.short], skeleton_class(n.role)), n.short
 
 
-def test_scenario_trace_is_bytes_the_generated_codec_parses_and_seeded_runs_repeat(spec):
-    """issue 4: nodes exchange BYTES through the generated codec; same seed -> same trace hash."""
+def test_scenario_trace_is_bytes_the_generated_codec_parses(spec):
+    """issue 4: nodes exchange BYTES through the generated codec. Same seed -> same trace: this scenario run twice
+    is tests/sim2d/test_cli.py's test_same_seed_prints_the_same_hash_and_metrics_cover_issue_4 (byte-identical
+    trace.tsv), and test_same_seed_same_trace_other_seed_other_trace here (CHOICE: a second 45 s run for the
+    same assertion was merged into those)."""
     path = ROOT / "scenarios" / "frame_loss.yaml"
     a = run_file(str(path), seed=3, spec=spec).result
-    b = run_file(str(path), seed=3, spec=spec).result
-    assert a.trace_hash == b.trace_hash and len(a.frames) == len(b.frames) > 1000
+    assert len(a.frames) > 1000
     corrupt = 0
     for f in a.frames:
         assert type(f.sent) is bytes and (f.heard is None or type(f.heard) is bytes)
