@@ -97,6 +97,22 @@ def test_left_whisker_turns_right_without_backing_off(spec):
     assert [m for t, m in moves(rig) if t >= 1.0][0] == MovCmd.TURN_RIGHT   # seed 3.2.12: OBJ_LEFT -> right
 
 
+def test_a_feeler_touch_leaves_both_its_wires_in_the_memory_the_motion_check_steers_by(spec):
+    """docs/decisions.md D18: the left switch says only that a wire of the left feeler touched something, so the
+    local memory gets points near the root, middle and tip of both wires: beside the front corner (the outer
+    wire) and across the body's lane ahead of the face (the inner wire). A thin post met by the inner wire is
+    then in the memory where the turn away would sweep the face into it (posts_low)."""
+    rig = np3(spec, task="idle")
+    rig.inject(1.0, MCP, data("TPSC", int(TpscContact.OBJ_LEFT)))
+    rig.run(1.01)
+    pts = body_frame(tuple(e.point() for e in rig.node.echoes), (0.0, 0.0, 0.0))
+    half_w = DEFAULT_GEOMETRY.body_width / 2
+    lane = [p for p in pts if p[0] > T.NP3_BODY_FRONT_M + 0.035 and 0.0 < p[1] < half_w]
+    beside = [p for p in pts if p[1] > half_w]
+    assert len(lane) >= 2 and len(beside) == 3, pts
+    assert all(p[1] > 0 for p in pts)                       # the left feeler's only
+
+
 def test_unreliable_ir_stops_the_robot_and_a_contact_cannot_restart_it(spec):
     rig = np3(spec)
     rig.inject(1.0, MCP, data("IRRC", int(RangeStatus.UNRELIABLE), STATUS))
