@@ -79,6 +79,7 @@ NP3_CONTACT_AHEAD_DEG = 60.0  # ... "ahead": its normal (IR line fit) within thi
 NP3_CONTACT_CLEAR_DEG = 20.0  # ... then turn until the surface's normal is this far behind the side (walk away),
 NP3_CONTACT_MIN_TURN_DEG = 30.0   # ... at least this far;
 NP3_CONTACT_WHISKER_NORMAL_DEG = 60.0  # a whisker alone (IR beams clear): the surface taken to face this far aside
+                              # (a touch of a feeler's lane wire too: its echoes keep the turn off the post, D18)
 NP3_CONTACT_CORNER_M = 0.01   # the IR centre point this far behind the line through the side points: a corner;
 NP3_CONTACT_CORNER_NORMAL_DEG = 45.0  # ... the side beams alone see a corner: its walls taken to face this far aside
 NP3_CONTACT_NEAR_M = 0.1      # ... a remembered echo beside the body this close to it: a wall alongside
