@@ -10,6 +10,33 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import NamedTuple
+
+
+class BodyPoint(NamedTuple):
+    """A point in the body frame (m): x forward from the body's centre, y to its left."""
+    x: float
+    y: float
+
+
+FeelerArm = tuple[BodyPoint, ...]   # a rigid wire from its root, point to point (seed 1.2.2 "Fühler")
+
+
+def mirrored(arms: tuple[FeelerArm, ...]) -> tuple[FeelerArm, ...]:
+    """The right feeler's arms from the left one's: the body is symmetric about its axis."""
+    return tuple(tuple(BodyPoint(p.x, -p.y) for p in arm) for arm in arms)
+
+
+def along(arm: FeelerArm, share: float) -> BodyPoint:
+    """The point `share` (0 root .. 1 tip) of the way along a wire: a touch is somewhere on it, the switch does
+    not say where."""
+    left = share * sum(math.dist(a, b) for a, b in zip(arm, arm[1:]))
+    for a, b in zip(arm, arm[1:]):
+        n = math.dist(a, b)
+        if 0 < n and left <= n:
+            return BodyPoint(a.x + left / n * (b.x - a.x), a.y + left / n * (b.y - a.y))
+        left -= n
+    return arm[-1]
 
 
 @dataclass(frozen=True)

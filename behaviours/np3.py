@@ -34,7 +34,7 @@ from arachnae_proto.skeletons.np3 import Np3Skeleton
 
 from behaviours import tuning as T
 from behaviours.gait import FIVE_LEGGED, STILL, Gait
-from behaviours.geometry import RobotGeometry
+from behaviours.geometry import RobotGeometry, along, mirrored
 from behaviours.np3_layers import (AVOIDANCE, REFLEXES, PinnedCheck, TaskModule, Tuning, body_frame, closing_in,
                                    np3_network, safe_instead, steepness_deg, uphill)
 from behaviours.runtime import Runtime
@@ -593,10 +593,10 @@ class NP3(Runtime, Np3Skeleton):
             right = bool(v & (TpscContact.OBJ_RIGHT | TpscContact.OBJ_BOTH))
             self.bump("whisker", left, right, self.now)                 # seed 3.2.12
             self.stopped_by_reflex(msg.address)
-            for side, hit in ((1.0, left), (-1.0, right)):   # the touch: anywhere along the whisker, so
-                for along in (0.2, 0.5, 0.85) if hit else ():     # points near its root, middle and tip
-                    self.echo(T.NP3_BODY_FRONT_M, side * T.NP3_WHISKER_Y_M, side * T.NP3_WHISKER_DEG,
-                              along * T.NP3_WHISKER_M)
+            for arms, hit in ((T.NP3_WHISKER_ARMS, left), (mirrored(T.NP3_WHISKER_ARMS), right)):
+                for arm in arms if hit else ():        # the touch: anywhere on the feeler's wires, so points
+                    for pt in (along(arm, k) for k in (0.2, 0.5, 0.85)):     # near each root, middle and tip
+                        self.echo(pt.x, pt.y, 0.0, 0.0)
         elif role == "IRRC" and 0 <= ch < 3:                            # seed 3.2.13: beam 0 left, 1 centre, 2 right
             self.ir[ch] = None if v >= _Q["IRRC"].hi else decode(role, v) / 100
             if self.ir[ch] is not None:

@@ -8,6 +8,8 @@ robot behaves, never what goes on the wire's format.
 """
 from __future__ import annotations
 
+from behaviours.geometry import BodyPoint
+
 # --- MMC (seed 3.2.4): gait clock, leg polling, errors
 MMC_CONTROL_S = 0.02          # gait generator period
 MMC_POLL_S = 0.04             # one LEG_POLL every 40 ms, legs in turn: each leg every 240 ms (a pit within ~0.5 s);
@@ -77,6 +79,7 @@ NP3_CONTACT_AHEAD_DEG = 60.0  # ... "ahead": its normal (IR line fit) within thi
 NP3_CONTACT_CLEAR_DEG = 20.0  # ... then turn until the surface's normal is this far behind the side (walk away),
 NP3_CONTACT_MIN_TURN_DEG = 30.0   # ... at least this far;
 NP3_CONTACT_WHISKER_NORMAL_DEG = 60.0  # a whisker alone (IR beams clear): the surface taken to face this far aside
+                              # (a touch of a feeler's lane wire too: its echoes keep the turn off the post, D18)
 NP3_CONTACT_CORNER_M = 0.01   # the IR centre point this far behind the line through the side points: a corner;
 NP3_CONTACT_CORNER_NORMAL_DEG = 45.0  # ... the side beams alone see a corner: its walls taken to face this far aside
 NP3_CONTACT_NEAR_M = 0.1      # ... a remembered echo beside the body this close to it: a wall alongside
@@ -183,9 +186,10 @@ NP3_SONAR_CARVE_S = 5.0       # ... a ping of the last 5 s clears the points of 
 NP3_SONAR_CARVE_TOL_M = 0.06  # ... and nearer than its own echo by this much (noise 2 cm, one step 4 cm; issue 17)
 NP3_BODY_FRONT_M = 0.15       # sensor mounts as the NP3 knows them: IR and whiskers at the body's front (CHOICE),
 NP3_IR_BEAM_DEG = 15.0        # ... the IR side beams at +-15 deg (seed 3.2.13),
-NP3_WHISKER_Y_M = 0.08        # ... the whiskers rooted this far either side of the axis (the corners, CHOICE) ...
-NP3_WHISKER_DEG = 25.0        # ... angled 25 deg outward (CHOICE, sim2d.robot_params) ...
-NP3_WHISKER_M = 0.10          # ... and 10 cm long (seed 1.2.2)
+NP3_WHISKER_ARMS = (          # ... and the left feeler's wires (the right one's mirrored), from its root at the
+    (BodyPoint(0.15, 0.08), BodyPoint(0.2406, 0.1223)),                  # front corner: 10 cm 25 deg outward ...
+    (BodyPoint(0.15, 0.08), BodyPoint(0.195, 0.08), BodyPoint(0.195, 0.015)),  # ... and bent across the lane ahead
+)                             # (seed 1.2.2, CHOICE: sim2d.robot_params.whisker_arms, docs/decisions.md D18)
 NP3_WALL_TARGET_M = 0.30      # wall following: body centre to the right-hand wall (feet reach 0.2 m sideways) ...
 NP3_WALL_DEADBAND_M = 0.05    # ... corrected by a sidestep when off by more than this
 NP3_WALL_CORNER_M = 0.45      # ... a wall ahead this close (centre) is a corner: turn left

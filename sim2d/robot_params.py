@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from behaviours.geometry import RobotGeometry
+from behaviours.geometry import BodyPoint, FeelerArm, RobotGeometry
 
 
 @dataclass(frozen=True)
@@ -32,12 +32,18 @@ class RobotParams(RobotGeometry):
     battery_empty_v: float = 4.2          # seed 3.2.17
     battery_ah: float = 2.0               # CHOICE
     battery_r_ohm: float = 0.05           # CHOICE: internal resistance
-    whisker_length: float = 0.10          # seed 1.2.2: tactile range "bis zu 10 cm"
-    # CHOICE: rooted at the body's front corners (y = +-body_width / 2), angled outward. They sweep 8-12.2 cm either
-    # side of the axis; 2.6-8 cm stays blind below the sonar head (docs/decisions.md D18: whiskers rooted 1.6 cm
-    # beside the axis, 40 deg outward, close that lane but leave the corners' surroundings unseen).
-    whisker_root_y: float = 0.08
-    whisker_angle: float = math.radians(25)  # outward from the body axis
+    # seed 1.2.2: rigid feelers for the near field "bis zu 10 cm", one end switch per side (3.2.12). CHOICE (their
+    # shape is not given; docs/decisions.md D18): the left feeler, rooted at the body's front corner, is a fork
+    # of two wires, each at most 11 cm long. The outer arm, straight, 10 cm at 25 deg outward, sweeps 8-12.2 cm
+    # beside the axis (what a turn on the spot sweeps the corner into); the inner arm runs 4.5 cm forward along
+    # the side line, then bends inward across the body's lane to 1.5 cm beside the axis, 4.5 cm ahead of the
+    # front face: a thin post there is touched with room to stop (the TPSC's STOP takes 3.3 cm). The right
+    # feeler is its mirror image (geometry.mirrored).
+    whisker_arms: tuple[FeelerArm, ...] = (
+        (BodyPoint(0.15, 0.08), BodyPoint(0.15 + 0.10 * math.cos(math.radians(25)),
+                                          0.08 + 0.10 * math.sin(math.radians(25)))),
+        (BodyPoint(0.15, 0.08), BodyPoint(0.195, 0.08), BodyPoint(0.195, 0.015)),
+    )
     ir_range: float = 0.10                # seed 3.2.13: "bis etwa 10 cm"
     ir_beams_deg: tuple[float, ...] = (15.0, 0.0, -15.0)   # seed 3.2.13: 0 deg and 15 deg either side
     us_range: float = 10.0                # seed 3.2.11: 10 m

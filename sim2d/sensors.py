@@ -11,6 +11,7 @@ import math
 import random
 from dataclasses import dataclass, field
 
+from behaviours.geometry import FeelerArm, mirrored
 from sim2d.geometry import Pt, to_world
 from sim2d.rng import stream
 from sim2d.robot import Robot
@@ -94,18 +95,27 @@ class Sensors:
         self.log.ir_rays = rays
         return tuple(out)
 
-    # seed 3.2.12: two rigid whiskers at the head, left and right
+    # seed 3.2.12: two end switches at the head, left and right, each closed by its rigid feeler (seed 1.2.2)
     def whiskers(self, t: float = 0.0) -> tuple[bool, bool]:
-        p = self.p
-        x, y, th = self.robot.pose
+        """(left, right): any arm of that side's feeler (robot_params.whisker_arms) meets an obstacle."""
         res = []
-        for side in (1.0, -1.0):
-            root = to_world(self.robot.pose, p.body_length / 2, side * p.whisker_root_y)
-            hit = self.world.ray(root, th + side * p.whisker_angle, p.whisker_length, p.whisker_height)
+        for arms in (self.p.whisker_arms, mirrored(self.p.whisker_arms)):
+            hit = self._feeler_hit(arms)
             if hit is not None:
                 self.log.whisker_hits.append((t, hit[1]))
             res.append(hit is not None)
         return res[0], res[1]
+
+    def _feeler_hit(self, arms: tuple[FeelerArm, ...]) -> tuple[float, Pt] | None:
+        """The first obstacle at least whisker_height tall met by a wire of the feeler, segment by segment."""
+        for arm in arms:
+            for a, b in zip(arm, arm[1:]):
+                start, end = to_world(self.robot.pose, a.x, a.y), to_world(self.robot.pose, b.x, b.y)
+                hit = self.world.ray(start, math.atan2(end[1] - start[1], end[0] - start[0]),
+                                     math.dist(start, end), self.p.whisker_height)
+                if hit is not None:
+                    return hit
+        return None
 
     def foot_contact(self, leg: int) -> bool:
         """Sole switch (seed 1.2.2): no contact over a pit."""

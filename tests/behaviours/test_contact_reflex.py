@@ -13,6 +13,7 @@ import pytest
 
 from behaviours.np3_layers import ContactModule, Tuning, contact_trigger, velocity
 from behaviours import tuning as T
+from behaviours.geometry import mirrored
 from sim2d.robot_params import DEFAULT as P
 
 TUNING = Tuning()
@@ -68,9 +69,9 @@ def sensed(walls: list[Wall]) -> dict:
     """seed 3.2.12, 3.2.13: the three IR beams (10 cm) and the two whiskers at the start pose, and the echoes."""
     front = (P.body_length / 2, 0.0)
     ir = tuple(ray(front, deg, P.ir_range, walls) for deg in P.ir_beams_deg)
-    deg = math.degrees(P.whisker_angle)
-    left, right = (ray((P.body_length / 2, side * P.whisker_root_y), side * deg, P.whisker_length, walls) is not None
-                   for side in (1.0, -1.0))
+    left, right = (any(ray(a, math.degrees(math.atan2(b.y - a.y, b.x - a.x)), math.dist(a, b), walls) is not None
+                       for arm in arms for a, b in zip(arm, arm[1:]))
+                   for arms in (P.whisker_arms, mirrored(P.whisker_arms)))
     return {"ir": ir, "whisker": (1, left, right, 0.0), "pose": (0.0, 0.0, 0.0), "echoes": sonar_echoes(walls)}
 
 

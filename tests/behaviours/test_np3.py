@@ -91,10 +91,30 @@ def test_switched_on_the_first_step_waits_for_what_the_ir_sees(spec):
 
 
 def test_left_whisker_turns_right_without_backing_off(spec):
+    """seed 3.2.12: OBJ_LEFT -> away to the right. The touch may be on the left feeler's lane wire ahead of the
+    face (docs/decisions.md D18), so the motion check steps the body aside before the turn that would sweep the
+    face into it; never back into what may lie behind."""
     rig = np3(spec)
     rig.inject(1.0, MCP, data("TPSC", int(TpscContact.OBJ_LEFT)))
-    rig.run(2.0)
-    assert [m for t, m in moves(rig) if t >= 1.0][0] == MovCmd.TURN_RIGHT   # seed 3.2.12: OBJ_LEFT -> right
+    rig.run(4.0)
+    after = [m for t, m in moves(rig) if t >= 1.0]
+    assert after[:2] == [MovCmd.SIDESTEP_RIGHT, MovCmd.TURN_RIGHT]
+
+
+def test_a_feeler_touch_leaves_both_its_wires_in_the_memory_the_motion_check_steers_by(spec):
+    """docs/decisions.md D18: the left switch says only that a wire of the left feeler touched something, so the
+    local memory gets points near the root, middle and tip of both wires: beside the front corner (the outer
+    wire) and across the body's lane ahead of the face (the inner wire). A thin post met by the inner wire is
+    then in the memory where the turn away would sweep the face into it (posts_low)."""
+    rig = np3(spec, task="idle")
+    rig.inject(1.0, MCP, data("TPSC", int(TpscContact.OBJ_LEFT)))
+    rig.run(1.01)
+    pts = body_frame(tuple(e.point() for e in rig.node.echoes), (0.0, 0.0, 0.0))
+    half_w = DEFAULT_GEOMETRY.body_width / 2
+    lane = [p for p in pts if p[0] > T.NP3_BODY_FRONT_M + 0.035 and 0.0 < p[1] < half_w]
+    beside = [p for p in pts if p[1] > half_w]
+    assert len(lane) >= 2 and len(beside) == 3, pts
+    assert all(p[1] > 0 for p in pts)                       # the left feeler's only
 
 
 def test_unreliable_ir_stops_the_robot_and_a_contact_cannot_restart_it(spec):

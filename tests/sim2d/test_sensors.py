@@ -53,16 +53,17 @@ def test_ir_beams_and_whiskers(write, spec):
 
 
 SEEN_AHEAD_M = 0.035     # issue 17: a whisker touch stops the legs ~0.33 s later, 3.3 cm at 10 cm/s
-LANE_WHISKERS = replace(P, whisker_root_y=0.016, whisker_angle=math.radians(40))   # docs/decisions.md D18
+CORNER_WHISKERS = replace(P, whisker_arms=P.whisker_arms[:1])   # docs/decisions.md D18: the outer arms alone
 
 
 @pytest.mark.parametrize("width", [0.02, 0.03])
-def test_whiskers_beside_the_nose_sense_every_thin_post_in_the_body_lane(write, spec, width):
-    """docs/decisions.md D18 (scenarios/open/posts_low.yaml): with the whiskers rooted 1.6 cm beside the axis and
-    angled 40 deg outward, walking straight at a post 12 cm tall (below the sonar head) of the given width,
-    wherever it overlaps the body's lane (its inner edge from 10 cm right to 8 cm left of the axis, in 5 mm
-    steps), the IR beams or a whisker touch it while its near face is still SEEN_AHEAD_M or more ahead of the
-    front face. The corner whiskers (the default mounts) leave 2.6-8 cm either side blind."""
+@pytest.mark.parametrize("params, blind_ok", [(P, False), (CORNER_WHISKERS, True)], ids=["feelers", "corner-only"])
+def test_the_feelers_sense_every_thin_post_in_the_body_lane(write, spec, width, params, blind_ok):
+    """docs/decisions.md D18 (scenarios/open/posts_low.yaml): walking straight at a post 12 cm tall (below the
+    sonar head) of the given width, wherever it overlaps the body's lane (its inner edge from 10 cm right to
+    8 cm left of the axis, in 5 mm steps), the IR beams or a feeler touch it while its near face is still
+    SEEN_AHEAD_M or more ahead of the front face. The outer (corner) arms alone leave 2.6-8 cm either side
+    blind: this check finds that lane."""
     half_w, front = P.body_width / 2, P.body_length / 2
     blind = []
     for k in range(int(round((2 * half_w + width) / 0.005))):
@@ -70,7 +71,7 @@ def test_whiskers_beside_the_nose_sense_every_thin_post_in_the_body_lane(write, 
         x0 = 1.0 + front + 0.12
         post = f"obstacles: [{{polygon: [[{x0}, {y0}], [{x0 + width}, {y0}], [{x0 + width}, {y0 + width}], " \
                f"[{x0}, {y0 + width}]], height: 0.12}}]\n"
-        s = sensors(write, post, params=LANE_WHISKERS)
+        s = sensors(write, post, params=params)
         seen = False
         for step in range(int(round((0.12 - SEEN_AHEAD_M) / 0.005)) + 1):    # the body walks up to the post
             s.robot.pose = (1.0 + 0.005 * step, 2.0, 0.0)
@@ -79,7 +80,10 @@ def test_whiskers_beside_the_nose_sense_every_thin_post_in_the_body_lane(write, 
                 break
         if not seen:
             blind.append(round(y0 - 2.0, 4))
-    assert blind == [], f"posts with their inner edge this far left of the axis (m) are not sensed: {blind}"
+    if blind_ok:
+        assert len(blind) >= 10, f"the corner arms alone leave only {blind} blind"
+    else:
+        assert blind == [], f"posts with their inner edge this far left of the axis (m) are not sensed: {blind}"
 
 
 def test_light_falls_with_distance_and_is_shaded_by_walls(write, spec):
@@ -116,7 +120,9 @@ def test_the_np3_knows_the_sensor_mounts_the_simulated_body_has():
     an echo from a whisker touch or an IR beam is placed where that copy says. Moving a mount in
     sim2d.robot_params (docs/decisions.md D18) without the copy would misplace every such echo silently."""
     assert T.NP3_BODY_FRONT_M == pytest.approx(P.body_length / 2)
-    assert T.NP3_WHISKER_Y_M == pytest.approx(P.whisker_root_y)
-    assert T.NP3_WHISKER_DEG == pytest.approx(math.degrees(P.whisker_angle))
-    assert T.NP3_WHISKER_M == pytest.approx(P.whisker_length)
+    assert len(T.NP3_WHISKER_ARMS) == len(P.whisker_arms)
+    for known, built in zip(T.NP3_WHISKER_ARMS, P.whisker_arms):
+        assert len(known) == len(built)
+        for k, b in zip(known, built):
+            assert (k.x, k.y) == (pytest.approx(b.x, abs=1e-4), pytest.approx(b.y, abs=1e-4))
     assert sorted(P.ir_beams_deg) == pytest.approx([-T.NP3_IR_BEAM_DEG, 0.0, T.NP3_IR_BEAM_DEG])
