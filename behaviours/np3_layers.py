@@ -511,7 +511,7 @@ class PinnedCheck:
     head and thinner than the gap between the IR fan (+-15 deg from the nose: 2.6 cm either side of the axis at
     its 10 cm reach) and straight corner whiskers (8 cm out, angled outward; the feelers' lane wires close that
     gap now, docs/decisions.md D18) meets the body's front unseen; the legs then walk on the spot and the dead
-    reckoning walks on (scenarios/open/posts_low.yaml with those whiskers and without this check: held for the
+    reckoning walks on (scenarios/posts_low.yaml with those whiskers and without this check: held for the
     whole run, 220 contacts). The sonar still hears the walls: walking forward, a range at a fixed scan
     angle changes with the body's progress unless the surface lies along the way. Pinned when, while FORWARD
     is walked (no step back or aside, no stop), pinned_angles angles on both sides of the axis each changed by

@@ -59,7 +59,7 @@ CORNER_WHISKERS = replace(P, whisker_arms=P.whisker_arms[:1])   # docs/decisions
 @pytest.mark.parametrize("width", [0.02, 0.03])
 @pytest.mark.parametrize("params, blind_ok", [(P, False), (CORNER_WHISKERS, True)], ids=["feelers", "corner-only"])
 def test_the_feelers_sense_every_thin_post_in_the_body_lane(write, spec, width, params, blind_ok):
-    """docs/decisions.md D18 (scenarios/open/posts_low.yaml): walking straight at a post 12 cm tall (below the
+    """docs/decisions.md D18 (scenarios/posts_low.yaml): walking straight at a post 12 cm tall (below the
     sonar head) of the given width, wherever it overlaps the body's lane (its inner edge from 10 cm right to
     8 cm left of the axis, in 5 mm steps), the IR beams or a feeler touch it while its near face is still
     SEEN_AHEAD_M or more ahead of the front face. The outer (corner) arms alone leave 2.6-8 cm either side
