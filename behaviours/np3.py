@@ -216,6 +216,7 @@ class GaitReckoning(DeadReckoning):
         super().__init__(0.0, 0.0, 0.0)
         self.gait = Gait(geometry)
         self.grip, self.step_s = grip, step_s
+        self.footless = False       # a foot stands over a pit (the MMC's NO_GROUND, till it clears): it carries nothing
         self.turn_grips = {int(MovCmd[name]): g for name, g in turn_grip.items()}
         self.turn_grips[FIVE_LEGGED] = self.turn_grips[int(MovCmd.WAVE)]      # seed 6.3: a wave over five legs
 
@@ -233,8 +234,9 @@ class GaitReckoning(DeadReckoning):
             self.gait.advance(self.step_s)
             m = self.gait.moved
             if m is not STILL:
-                self.x, self.y, self.th = displaced(self.x, self.y, self.th, m.fwd_m * self.grip,
-                                                    m.left_m * self.grip, m.turn_rad * self.turn_grip)
+                lost = T.NP3_DR_FOOTLESS_GRIP if self.footless else 1.0
+                self.x, self.y, self.th = displaced(self.x, self.y, self.th, m.fwd_m * self.grip * lost,
+                                                    m.left_m * self.grip * lost, m.turn_rad * self.turn_grip * lost)
                 self.keep(self.t)
 
     def command(self, now: float, cmd: int) -> None:
@@ -265,12 +267,20 @@ class HeadingPlan(NamedTuple):
     fights: int                   # times a stronger layer had taken the actuator by then
 
 
+class RingOut(NamedTuple):
+    """A ring of pits round the robot (NP3.ringed): its middle (DR frame) and how far from it the outside begins."""
+    x: float
+    y: float
+    radius: float
+
+
 class PlanRecord(NamedTuple):
     """One task-layer decision (seed 3.3.2), kept for plans.tsv: where the robot thought it was, what it chose."""
     t: float
     x: float
     y: float
-    kind: str                               # "heading" (the map's least-passed open ray), "frontier" (a route), "none"
+    kind: str                               # "heading" (the map's least-passed open ray), "frontier" (a route),
+                                            # "out" (a route out of a ring of pits), "none"
     fresh_m: float                          # the best heading's not-yet-passed length (explore; 0 otherwise)
     route: tuple[tuple[float, float], ...]  # the waypoints planned, the goal last
 
@@ -279,6 +289,9 @@ class Np3Map(TypedDict):
     places: int
     edges: int
     routes: int
+    routes_out: int               # of them, routes out of a ring of pits (NP3.ringed)
+    rings_left: int               # times the robot stood beyond the pits that hemmed it in
+    pit_cells: int                # map cells a foot's NO_GROUND marked
     seen_m2: float
     heading_fixed_deg: float      # the heading corrections from the map, summed
 
@@ -347,6 +360,11 @@ class NP3(Runtime, Np3Skeleton):
         self.planned_at = -math.inf           # the last full plan (a rebuilt map): at most one per NP3_PLAN_CHANGED_S
         self.goal: tuple[float, float] | None = None
         self.routes_planned = 0               # routes planned over the topological map (3.3.2)
+        self.routes_out = 0                   # ... of them out of a ring of pits
+        self.rings_left = 0                   # times the robot stood beyond the pits that hemmed it in (ringed)
+        self.pit_cells: dict[tuple[int, int], tuple[float, float]] = {}   # map cell -> point a pit's edge marked
+        self.pits_met = 0                     # pit edges the feet found (mark_pit) since the robot last left a ring
+        self.ring: RingOut | None = None      # the pits found hem the robot in (ringed): the ring's middle
         self.frontier_target = FrontierTarget(T.NP3_PLAN_EXCLUDE_M, T.NP3_PLAN_PROGRESS_M, T.NP3_PLAN_PATIENCE_S)
         self.plans: list[PlanRecord] = []     # every full plan, for plans.tsv (what was planned vs what happened)
         self.heading_plan: HeadingPlan | None = None
@@ -455,6 +473,12 @@ class NP3(Runtime, Np3Skeleton):
         self.next_plan = now + T.NP3_EXPLORE_PLAN_S
         self.map.plan = []
         self.not_approached(x, y)
+        ring = self.ringed(x, y)
+        if ring is not None:                       # pits all round: the way out over the map, through its gap
+            self.goal = self.route_out(x, y, ring)
+            if self.goal is not None:
+                self.chose(now, "out", 0.0)
+                return
         if self.cfg.task == "seek_light":          # searching for a light it cannot see: the nearest unknown
             # the widest opening onto the unknown first, round walls by the map (a lamp behind a wall)
             self.goal = self.route_to_frontier(x, y, now, T.NP3_SEEK_FRONTIER_WEIGHT_M)
@@ -651,7 +675,7 @@ class NP3(Runtime, Np3Skeleton):
                 self.stopped_by_mmc(_STOP)           # ... the MMC stopped there at once (mmc.py, seed 1.2.2)
                 fx, fy = self.geo.neutral_foot(leg) if leg in self.geo.legs else (self.geo.hip_x[0], 0.0)
                 self.echo(fx, fy, 0.0, 0.0)          # the edge joins the local memory (the motion check) ...
-                self.map.grid.mark_barrier(*self.at_body(fx, fy))   # ... and the map: the pit is part of it (3.3.2)
+                self.mark_pit(fx, fy)                # ... and the map: the pit is part of it (3.3.2)
                 self.map_changed()
                 self.bump("pit", fx, fy)
             elif error == _BLOCKED:
@@ -659,6 +683,78 @@ class NP3(Runtime, Np3Skeleton):
             elif error in _LEG_LOST and leg in self.geo.legs:
                 self.odo.leg_lost(self.now, leg)     # seed 6.3: the MMC walks on five from now on
         self.mmc_error = (error, leg)
+        if isinstance(self.odo, GaitReckoning):
+            self.odo.advance(self.now)
+            self.odo.footless = error == _NO_GROUND
+
+    def mark_pit(self, fx: float, fy: float) -> None:
+        """seed 1.2.2 / 3.3.2: a foot found no ground at (fx, fy) (body frame): the pit's edge joins the map.
+
+        CHOICE: as a stretch NP3_PIT_EDGE_DEEP_M deep from the foot on, across the way the foot went (ahead of a front
+        foot, behind a rear one, beside a middle one): a front or rear foot's from the body's axis out to
+        NP3_PIT_EDGE_OUT_M beyond the foot (the other side's foot stands on ground, so the edge does not cross
+        the axis), a middle foot's NP3_PIT_EDGE_ALONG_M either way along the body (its neighbours on that side
+        stand on ground). One cell per report left a ring of pits as scattered dots the sonar's free space
+        lay between (the sonar sees no hole), so no route over the map went round it (pit_ring, issue 17).
+        The edge's true direction is not known: one met diagonally, or beside the body in a gap, is marked
+        square to the body, and a stretch centred on the foot closed pit_ring's gap on the map from both sides.
+        """
+        g = self.map.grid
+        step = g.res / 2
+        if abs(fx) >= 0.05:                     # a front or rear foot: the edge ahead of it (behind it)
+            nx, ny = math.copysign(1.0, fx), 0.0
+            out = fy + math.copysign(T.NP3_PIT_EDGE_OUT_M, fy) if fy else T.NP3_PIT_EDGE_OUT_M
+            lo, hi = sorted((0.0 if fy else -out, out))
+            across = [(fx, lo + k * step) for k in range(int(round((hi - lo) / step)) + 1)]
+        else:                                   # a middle foot: the edge beside it
+            nx, ny = 0.0, math.copysign(1.0, fy)
+            k = int(round(T.NP3_PIT_EDGE_ALONG_M / step))
+            across = [(fx + m * step, fy) for m in range(-k, k + 1)]
+        self.pits_met += 1
+        for depth in (k * step for k in range(int(round(T.NP3_PIT_EDGE_DEEP_M / step)) + 1)):
+            for bx, by in across:
+                wx, wy = self.at_body(bx + depth * nx, by + depth * ny)
+                g.mark_barrier(wx, wy)
+                self.pit_cells.setdefault(g.cell(wx, wy), (wx, wy))
+
+    def ringed(self, x: float, y: float) -> RingOut | None:
+        """seed 3.3.2: while the pits found hem the robot in, the ring they lie on (the middle of its path till
+        then, and NP3_RING_OUT_M beyond the farthest pit cell found near that); None when they do not hem it
+        in, or once it stands beyond that.
+
+        CHOICE: hemmed in = the feet found NP3_RING_PITS pit edges (the way the robot chose ended at a pit,
+        and the next way again): it stops following the open rays the sonar sees over the holes and plans a
+        way out. Measured, pit_ring seeds 1-10 at 120 s: with two edges facing 90 deg apart asked for, the
+        robot stood in the gap at 41 s (seed 5) and was sent back in by an open ray; any two: 8 of 10 out. The ring's middle is the mean of the
+        path walked till then: the robot walked only where the ground held, inside the ring (where it stood
+        when it found the second pit was no middle: in the gap, with a pit either side, the ring's inside lay
+        beyond those two)."""
+        if self.ring is None and self.pits_met >= T.NP3_RING_PITS:
+            path = self.map.path
+            self.ring = RingOut(sum(p[0] for p in path) / len(path), sum(p[1] for p in path) / len(path), 0.0)
+        if self.ring is None:
+            return None
+        c = (self.ring.x, self.ring.y)
+        far = max((d for p in self.pit_cells.values() if (d := math.dist(p, c)) <= T.NP3_RING_NEAR_M), default=0.0)
+        self.ring = self.ring._replace(radius=far + T.NP3_RING_OUT_M)
+        if math.dist((x, y), c) > self.ring.radius:        # out: explore on; pits met from here on count anew
+            self.ring, self.rings_left = None, self.rings_left + 1
+            self.pits_met = 0
+        return self.ring
+
+    def route_out(self, x: float, y: float, ring: RingOut) -> tuple[float, float] | None:
+        """seed 3.3.2: a route over the rebuilt map out of the ring of pits (TopoMap.route_out); its first waypoint."""
+        self.map.rebuild()
+        route = self.map.route_out((x, y), (ring.x, ring.y), ring.radius, list(self.pit_cells.values()),
+                                   T.NP3_RING_WARY_M, T.NP3_RING_WARY_COST)
+        while route and len(route) > 1 and math.dist(route[0], (x, y)) < T.NP3_GOAL_REACHED_M:
+            route.pop(0)
+        self.map.plan = route or []
+        if not route:
+            return None
+        self.routes_planned += 1
+        self.routes_out += 1
+        return route[0]
 
     def range_status(self, role: str, status: int) -> None:
         bad = status in _IR_BAD
@@ -787,6 +883,7 @@ class NP3(Runtime, Np3Skeleton):
             "ir_fault": self.ir_fault,
             "sonar_ignored": self.sonar_ignored,
             "map": {"places": len(self.map.places), "edges": len(self.map.edges), "routes": self.routes_planned,
+                    "routes_out": self.routes_out, "rings_left": self.rings_left, "pit_cells": len(self.pit_cells),
                     "seen_m2": round(sum(self.map.grid.seen) * self.map.grid.res ** 2, 2),
                     "heading_fixed_deg": round(math.degrees(self.heading_fixed), 1)},
             "light": {"first_lux": round(self.lux[0], 1), "last_lux": round(self.lux[-1], 1),
@@ -795,7 +892,8 @@ class NP3(Runtime, Np3Skeleton):
 
     def write_artifacts(self, out_dir: Path) -> None:
         """control.tsv (the control trace), wiring.txt (the declared network), topomap.png and plans.tsv (seed
-        3.3.2: the map with the plan followed at the end, and every plan made)."""
+        3.3.2: the map with the pits found, the routes out of a ring of them and the plan followed at the end,
+        and every plan made)."""
         out = Path(out_dir)
         rows = ["start_s\tend_s\tlayer\tmodule"]
         if "move" in self.layers.traces:
@@ -808,7 +906,8 @@ class NP3(Runtime, Np3Skeleton):
         # seeking a light the samples show, the task climbs its gradient and the map's plan is not followed
         following = self.cfg.task == "seek_light" and isinstance(task, TaskModule) and not task.dark()
         self.map.save_png(out / "topomap.png", given_up=self.frontier_target.given_up,
-                          plan=[] if following else None)
+                          plan=[] if following else None, pits=self.pit_cells.values(),
+                          routes=[((p.x, p.y), *p.route) for p in self.plans if p.kind == "out"])
         plans = ["t_s\tx_m\ty_m\tkind\tfresh_m\troute"]
         plans += [f"{p.t:.2f}\t{p.x:.2f}\t{p.y:.2f}\t{p.kind}\t{p.fresh_m:.2f}\t"
                   + " ".join(f"{wx:.2f},{wy:.2f}" for wx, wy in p.route) for p in self.plans]

@@ -231,6 +231,20 @@ class HeadingVotes:
         return max(-self.max_step, min(self.max_step, self.gain * mid))
 
 
+def _pit_distance(g: OccupancyGrid, pits: Sequence[tuple[float, float]], reach_m: float) -> dict[tuple[int, int], float]:
+    """The distance (m) from each cell within `reach_m` of some pit point to the nearest one."""
+    out: dict[tuple[int, int], float] = {}
+    n = int(math.ceil(reach_m / g.res))
+    for px, py in pits:
+        pi, pj = g.cell(px, py)
+        for j in range(pj - n, pj + n + 1):
+            for i in range(pi - n, pi + n + 1):
+                d = math.dist(g.centre(i, j), (px, py))
+                if d <= reach_m and d < out.get((i, j), math.inf):
+                    out[(i, j)] = d
+    return out
+
+
 def ray_cells(x: float, y: float, angle: float, length: float, res: float, x0: float = 0.0,
               y0: float = 0.0) -> Iterable[tuple[int, int]]:
     """Every grid cell the ray from (x, y) crosses within `length` (Amanatides-Woo traversal)."""
@@ -438,6 +452,72 @@ class TopoMap:
                     heapq.heappush(todo, (d + h(by_id[n]), n))
         return None
 
+    def route_out(self, start: tuple[float, float], centre: tuple[float, float], radius_m: float,
+                  pits: Sequence[tuple[float, float]], wary_m: float, wary_cost: float,
+                  start_m: float = 0.4) -> list[tuple[float, float]] | None:
+        """seed 3.3.2: a way out of a ring of pits: the cheapest path over the grid from `start` to a cell more
+        than `radius_m` from `centre`, as waypoints (the straight stretches the robot's disc fits along, the
+        goal last); None when the map leaves none (call rebuild() first, for the clearance).
+
+        Over grid cells, not the places graph: one place per `place_spacing_m` block (1 m for the NP3) cannot
+        stand in a 0.8 m gap, and an edge through it must then run straight from block to block. A cell is
+        passable where the robot's disc fits (clearance >= its radius), or within `start_m` of the start (it
+        backed off from a pit: its own ground is free). CHOICE: a cell within `wary_m` of a pit cell found
+        (`pits`) costs up to `wary_cost` times its length more, the most next to it: a pit's edge runs on
+        past what one foot found, so the way out is tried first where no pit has been met, not along the
+        ends of the stretches already mapped (that slid round the ring 0.3 m per pit report).
+        """
+        g, r = self.grid, self.robot_radius_m
+        s0 = g.cell(*start)
+        if not g.inside(*s0) or not self.clearance:
+            return None
+        near = _pit_distance(g, pits, wary_m)
+        best = {s0: 0.0}
+        came: dict[tuple[int, int], tuple[int, int]] = {}
+        todo = [(0.0, s0)]
+        goal: tuple[int, int] | None = None
+        while todo:
+            d, c = heapq.heappop(todo)
+            if d > best.get(c, math.inf):
+                continue
+            if math.dist(g.centre(*c), centre) > radius_m:
+                goal = c
+                break
+            for di, dj in _N8:
+                n = (c[0] + di, c[1] + dj)
+                if not g.inside(*n):
+                    continue
+                k = n[1] * g.nx + n[0]
+                if self.clearance[k] < r and not (g.state(*n) == FREE and math.dist(g.centre(*n), start) <= start_m):
+                    continue
+                wary = 1.0 + wary_cost * max(0.0, 1.0 - near.get(n, math.inf) / wary_m)
+                nd = d + g.res * math.hypot(di, dj) * wary
+                if nd < best.get(n, math.inf):
+                    best[n], came[n] = nd, c
+                    heapq.heappush(todo, (nd, n))
+        if goal is None:
+            return None
+        cells = [goal]
+        while cells[-1] != s0:
+            cells.append(came[cells[-1]])
+        cells.reverse()
+        return self._straightened(start, [g.centre(*c) for c in cells])
+
+    def _straightened(self, start: tuple[float, float], pts: list[tuple[float, float]]) -> list[tuple[float, float]]:
+        """A grid path as few waypoints: from each waypoint on, the farthest point of the path the robot's disc
+        reaches in a straight passable line (the first step always, whatever its clearance)."""
+        out: list[tuple[float, float]] = []
+        at, k = start, 0
+        while k < len(pts) - 1:
+            nxt = k + 1
+            for m in range(len(pts) - 1, k + 1, -1):
+                if self.passable(at, pts[m]):
+                    nxt = m
+                    break
+            at, k = pts[nxt], nxt
+            out.append(at)
+        return out or pts[-1:]
+
     @staticmethod
     def length(start: tuple[float, float], route: Sequence[tuple[float, float]]) -> float:
         """The length (m) of a route's waypoints walked from `start`."""
@@ -529,10 +609,13 @@ class TopoMap:
     # -- picture --------------------------------------------------------------------
     def save_png(self, path: str | Path, px_per_cell: int = 4,
                  given_up: Sequence[tuple[float, float]] = (),
-                 plan: Sequence[tuple[float, float]] | None = None) -> Path:
-        """Grid (unknown grey, free white, occupied black), room outline, edges, places, robot path, the plan
-        (green, to a square at its goal; `plan` instead of self.plan when the caller knows better) and
-        frontiers given up (FrontierTarget, purple crosses)."""
+                 plan: Sequence[tuple[float, float]] | None = None,
+                 routes: Sequence[Sequence[tuple[float, float]]] = (),
+                 pits: Iterable[tuple[float, float]] = ()) -> Path:
+        """Grid (unknown grey, free white, occupied black, pit cells dark red), room outline, edges, places,
+        robot path, earlier `routes` (thin green, each from where it was planned), the plan (green, to a square
+        at its goal; `plan` instead of self.plan when the caller knows better) and frontiers given up
+        (FrontierTarget, purple crosses)."""
         from PIL import Image, ImageDraw
 
         g, s = self.grid, px_per_cell
@@ -549,6 +632,10 @@ class TopoMap:
         def px(x: float, y: float) -> tuple[float, float]:
             return (x - g.x0) / g.res * s, (g.ny - (y - g.y0) / g.res) * s
 
+        for i, j in {g.cell(*p) for p in pits}:
+            top = (g.ny - 1 - j) * s
+            draw.rectangle((i * s, top, i * s + s - 1, top + s - 1), fill=(150, 0, 0))
+
         if self.room:
             draw.polygon([px(*p) for p in self.room], outline=(0, 160, 0))
         by_id = {p.id: p for p in self.places}
@@ -559,6 +646,9 @@ class TopoMap:
             draw.ellipse((cx - r, cy - r, cx + r, cy + r), fill=(220, 30, 30))
         if len(self.path) > 1:
             draw.line([px(*p) for p in self.path], fill=(230, 140, 0), width=2)
+        for r in routes:
+            if len(r) > 1:
+                draw.line([px(*p) for p in r], fill=(120, 210, 140), width=1)
         plan = self.plan if plan is None else list(plan)
         if plan:                                       # the route being followed, from the robot on
             pts = [px(*p) for p in ([self.path[-1]] if self.path else []) + plan]

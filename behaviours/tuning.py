@@ -135,6 +135,15 @@ NP3_PLAN_EXCLUDE_M = 0.5      # ... committed to until no frontier cell is left 
 NP3_PLAN_PROGRESS_M = 0.3     # ... and given up when its route has not shortened by this much ...
 NP3_PLAN_PATIENCE_S = 40.0    # ... for this long (4 replans: walked round walls at 0.09 m/s, a route shortens faster)
 NP3_PLAN_CHANGED_S = 1.0      # ... and planned again this soon after a pit or refused slope joins the map
+NP3_PIT_EDGE_OUT_M = 0.3      # a front or rear foot's NO_GROUND marks the pit's edge from the body's axis to this far
+                              # beyond the foot (issue 17, pit_ring) ...
+NP3_PIT_EDGE_ALONG_M = 0.15   # ... a middle foot's this far either way along the body ...
+NP3_PIT_EDGE_DEEP_M = 0.3     # ... this deep: a hole the body cannot step over (the step limit is centimetres)
+NP3_RING_PITS = 2             # hemmed in by pits (3.3.2): the feet found this many pit edges (one per NO_GROUND) ...
+NP3_RING_NEAR_M = 3.0         # ... plans a way out to this far beyond the farthest pit cell found this near the
+NP3_RING_OUT_M = 0.5          # ... middle of its path,
+NP3_RING_WARY_M = 0.6         # ... wary of ground this near a pit cell found (a pit's edge runs on) ...
+NP3_RING_WARY_COST = 4.0      # ... which costs up to this many times its length more
 NP3_SEEK_FRONTIER_WEIGHT_M = 0.1  # seeking a light no sample shows: a frontier cell is worth this much path (the
                               # widest opening onto the unknown, where a lamp behind a wall is, before the nearest)
 NP3_HEADING_TOL_DEG = 20.0    # steering: turn on the spot while the goal is further off the axis than this
@@ -157,6 +166,10 @@ NP3_LIGHT_FLAT_STEPS = 5      # seeking light: samples spanning fewer than this 
 NP3_MAP_SIZE_M = 12.0         # topological map: a square this wide around the start ...
 NP3_MAP_CELL_M = 0.1          # ... in cells this wide
 NP3_SONAR_BEAM_DEG = 15.0     # width a sonar echo is spread over on the map (40 kHz transducer cone)
+NP3_DR_FOOTLESS_GRIP = 0.0     # dead reckoning while the MMC reports a foot without ground: none of the motion counts
+                              # (CHOICE, issue 17: turning with a foot over a pit the body turned a fraction of the
+                              # gait's turn; worst heading error, pit_ring seeds 1-5 at 180 s, bench/dr_heading.py:
+                              # 19-179 deg, mean 76, counting it all; 19-48, mean 32, counting none)
 NP3_DR_SPEED_M_S = 0.09       # dead reckoning: forward / backward speed (bench: the gait's nominal 0.1 m/s
 NP3_DR_SIDE_M_S = 0.083       # ... loses ~10 % re-phasing), sidestep speed,
 NP3_DR_TURN_DEG_S = 22.5      # ... and turn rate on the spot (nominal 25 deg/s), all measured in sim2d

@@ -473,7 +473,7 @@ def test_a_pit_found_has_the_task_layer_plan_again_at_once(spec):
     assert [p.t for p in quiet.node.plans if p.t > 1.0] == []                # the periodic plan is 10 s away
     again = [p for p in pit.node.plans if p.t > 3.0]
     assert len(again) == 1 and again[0].t <= 3.0 + T.NP3_PLAN_CHANGED_S + 0.1
-    assert len(pit.node.map.grid.barriers) == 1
+    assert pit.node.map.grid.barriers and set(pit.node.pit_cells) == pit.node.map.grid.barriers
 
 
 def test_a_heading_goal_avoidance_kept_the_robot_from_is_not_chosen_again_there(spec):
@@ -502,15 +502,72 @@ def test_a_heading_goal_avoidance_kept_the_robot_from_is_not_chosen_again_there(
 def test_a_pit_under_a_rear_foot_is_left_forwards_and_stays_on_the_map(spec):
     rig = np3(spec)
     rig.inject(1.0, MCP, data("MMC", int(MmcError.NO_GROUND), STATUS, channel=3))   # leg 3: rear left
+    rig.run(1.05)
+    x0 = rig.node.pose_at(None)[0]
     rig.run(1.5)
     assert command_at(rig, 1.5) == MovCmd.FORWARD and rig.node.takeovers.get("pit") == 1
     rig.run(1.0 + T.NP3_PIT_BACK_S + 0.5)
     assert command_at(rig, 1.0 + T.NP3_PIT_BACK_S + 0.5) == MovCmd.TURN_RIGHT      # away from the left side
     g = rig.node.map.grid
-    assert len(g.barriers) == 1
-    (i, j), = g.barriers
-    g.mark_free(*g.centre(i, j), 0.3)                                               # walking there later ...
-    assert g.state(i, j) == 2                                                       # ... does not clear it
+    assert g.barriers and all(g.centre(i, j)[0] < x0 - 0.05 for i, j in g.barriers)  # behind the body
+    for i, j in g.barriers:
+        g.mark_free(*g.centre(i, j), 0.3)                                           # walking there later ...
+    assert all(g.state(i, j) == 2 for i, j in g.barriers)                           # ... does not clear it
+
+
+def test_a_front_foot_over_a_pit_marks_a_stretch_of_its_edge_ahead_on_its_own_side(spec):
+    """CHOICE (NP3.mark_pit, issue 17): one cell per NO_GROUND left a ring of pits as dots the sonar's free space
+    lay between; the edge joins the map as a stretch across the way ahead, from the body's axis (the other front
+    foot stands on ground) to beyond the foot, and NP3_PIT_EDGE_DEEP_M deep."""
+    rig = np3(spec)
+    rig.inject(1.0, MCP, data("MMC", int(MmcError.NO_GROUND), STATUS, channel=1))   # leg 1: front left
+    rig.run(1.05)
+    g = rig.node.map.grid
+    pts = [g.centre(i, j) for i, j in g.barriers]
+    fx, fy = DEFAULT_GEOMETRY.neutral_foot(1)
+    assert all(x > fx - g.res and y > -g.res for x, y in pts)                     # ahead, not right of the axis
+    ys, xs = [y for _x, y in pts], [x for x, _y in pts]
+    assert max(ys) - min(ys) >= fy + T.NP3_PIT_EDGE_OUT_M - g.res                 # a stretch across the way
+    assert max(xs) - min(xs) >= T.NP3_PIT_EDGE_DEEP_M - g.res                     # ... and deep
+
+
+def test_pits_found_twice_have_the_task_layer_plan_a_route_out(spec, tmp_path):
+    """seed 3.3.2, issue 17: the feet found a pit ahead and then, turned away, ahead again (NP3_RING_PITS): the
+    task layer stops following open rays and plans a route over the map to beyond the pits found (kind "out"),
+    within NP3_PLAN_CHANGED_S, the picture drawing it."""
+    rig = np3(spec, task="explore")
+    rig.inject(3.0, MCP, data("MMC", int(MmcError.NO_GROUND), STATUS, channel=1))   # front left: a pit ahead
+    rig.inject(3.6, MCP, data("MMC", 0, STATUS, channel=0))                         # the foot back on ground
+    rig.run(14.0)
+    node = rig.node
+    for _k in range(20):                        # what the sonar would have shown: free ground all round
+        node.map.grid.mark_free(0.0, 0.0, 3.0)
+    assert node.routes_out == 0 and all(p.kind != "out" for p in node.plans)
+    assert abs(node.odo.th) >= math.radians(90)                                     # the reflex turned it away
+    rig.inject(14.0, MCP, data("MMC", int(MmcError.NO_GROUND), STATUS, channel=4))  # front right: ahead again
+    rig.run(14.0 + T.NP3_PLAN_CHANGED_S + 0.2)
+    out = [p for p in node.plans if p.kind == "out"]
+    assert out and out[0].t <= 14.0 + T.NP3_PLAN_CHANGED_S + 0.1 and node.routes_out >= 1
+    ring = node.ring
+    assert ring is not None and math.dist(out[0].route[-1], (ring.x, ring.y)) > ring.radius
+    node.write_artifacts(tmp_path)
+    colours = set(Image.open(tmp_path / "topomap.png").convert("RGB").getdata())
+    assert {(150, 0, 0), (0, 170, 60)} <= colours        # the pits found, the route out followed
+
+
+def test_the_reckoning_counts_no_motion_while_a_foot_has_no_ground(spec):
+    """CHOICE (GaitReckoning.footless, issue 17): turning with a foot over a pit the body turned a fraction of what
+    the gait commanded (pit_ring seed 4: 50 deg off in 3.5 s of a pit reflex's turn); while the MMC reports the
+    foot without ground the reckoning counts no motion, and from its clear on it counts again."""
+    rig = np3(spec)
+    rig.inject(1.0, MCP, data("MMC", int(MmcError.NO_GROUND), STATUS, channel=1))
+    rig.inject(2.5, MCP, data("MMC", 0, STATUS, channel=0))
+    rig.run(1.1)
+    held = rig.node.pose_at(None)
+    rig.run(2.4)
+    assert command_at(rig, 2.4) == MovCmd.BACKWARD and rig.node.pose_at(None) == held
+    rig.run(3.4)
+    assert rig.node.pose_at(None)[0] < held[0] - 0.02                                # backing off, counted
 
 
 def test_dead_reckoning_knows_the_pose_at_an_earlier_time():

@@ -319,6 +319,60 @@ def test_a_route_out_of_a_ring_of_pits_takes_its_one_gap():
     assert m.route((3.0, 2.0), (5.2, 2.0)) is None
 
 
+def _ring_map(place_spacing_m: float) -> TopoMap:
+    """pit_ring's room as the sonar sees it (over the pits: it sees no hole), and the ring's inner edges as the
+    feet found them, but for the 0.8 m gap on the east side (1.6 < y < 2.4)."""
+    m = TopoMap(OccupancyGrid(-0.5, -0.5, 7.0, 5.0, 0.1), robot_radius_m=0.16, place_spacing_m=place_spacing_m)
+    for pose in ((3.0, 2.0, 90), (1.0, 0.5, 0), (5.0, 3.5, 0)):
+        m.add_scan(scan(box(0, 0, 6, 4), *pose))
+    for k in range(41):
+        x, y = 2.0 + k * 0.05, 1.0 + k * 0.05
+        m.grid.mark_barrier(x, 1.0)
+        m.grid.mark_barrier(x, 3.0)
+        m.grid.mark_barrier(2.0, y)
+        if not 1.6 < y < 2.4:
+            m.grid.mark_barrier(4.0, y)
+    m.rebuild()
+    return m
+
+
+def _inside_ring(p: tuple[float, float]) -> bool:
+    return 2.0 < p[0] < 4.0 and 1.0 < p[1] < 3.0
+
+
+def test_a_route_out_leaves_a_ring_of_pits_through_its_gap():
+    """seed 3.3.2, issue 17: with no goal point, only a radius round the ring's middle to get beyond, the route
+    out over the grid's cells leaves through pit_ring's gap, in straight stretches the robot's disc fits along."""
+    m = _ring_map(place_spacing_m=1.0)
+    route = m.route_out((3.0, 2.0), (3.0, 2.0), 1.9, [], 0.6, 4.0)
+    assert route is not None and math.dist(route[-1], (3.0, 2.0)) > 1.9 and route[-1][0] > 4.4
+    legs = list(zip([(3.0, 2.0)] + route, route))
+    out = [(a, b) for a, b in legs if _inside_ring(a) != _inside_ring(b)]
+    assert len(out) == 1 and out[0][1][0] >= 4.0
+    assert all(m.passable(a, b) for a, b in legs[1:])
+    for k in range(9):                                   # the gap found too: no way out
+        m.grid.mark_barrier(4.0, 1.6 + 0.1 * k)
+    m.rebuild()
+    assert m.route_out((3.0, 2.0), (3.0, 2.0), 1.9, [], 0.6, 4.0) is None
+
+
+def test_a_route_out_keeps_clear_of_the_pits_found_when_it_can():
+    """CHOICE (TopoMap.route_out): a pit's edge runs on past what the feet found, so the way out is wary of the
+    ground near the pit cells found: with them costing more it leaves further from them than the shortest way,
+    which runs round the end of the stretch found."""
+    m = TopoMap(OccupancyGrid(-0.5, -0.5, 7.0, 5.0, 0.1), robot_radius_m=0.16, place_spacing_m=1.0)
+    m.add_scan(scan(box(0, 0, 6, 4), 3.0, 2.0))
+    pits = [(2.0 + 0.05 * k, 1.0) for k in range(41)]          # the south edge, found from x 2 to 4
+    for p in pits:
+        m.grid.mark_barrier(*p)
+    m.rebuild()
+    near = lambda route: min(math.dist(w, p) for w in route for p in pits)          # noqa: E731
+    bold = m.route_out((3.0, 1.4), (3.0, 2.0), 1.4, pits, 0.6, 0.0)
+    wary = m.route_out((3.0, 1.4), (3.0, 2.0), 1.4, pits, 0.6, 4.0)
+    assert bold is not None and wary is not None
+    assert near(bold) < 0.6 <= near(wary)
+
+
 def test_occupied_near_lists_the_occupied_cells_within_the_radius():
     g = OccupancyGrid(0.0, 0.0, 4.0, 4.0, 0.1)
     g.integrate(Reading(1.0, 2.0, 0.0, 0.0, 0.8))             # an echo 0.8 m east of (1, 2)
