@@ -216,7 +216,7 @@ class GaitReckoning(DeadReckoning):
         super().__init__(0.0, 0.0, 0.0)
         self.gait = Gait(geometry)
         self.grip, self.step_s = grip, step_s
-        self.footless = False       # a foot stands over a pit (the MMC's NO_GROUND, till it clears): it carries nothing
+        self.footless = False       # seed 1.2.2: a foot stands over a pit (the MMC's NO_GROUND, till it clears)
         self.turn_grips = {int(MovCmd[name]): g for name, g in turn_grip.items()}
         self.turn_grips[FIVE_LEGGED] = self.turn_grips[int(MovCmd.WAVE)]      # seed 6.3: a wave over five legs
 
@@ -683,15 +683,15 @@ class NP3(Runtime, Np3Skeleton):
             elif error in _LEG_LOST and leg in self.geo.legs:
                 self.odo.leg_lost(self.now, leg)     # seed 6.3: the MMC walks on five from now on
         self.mmc_error = (error, leg)
-        if isinstance(self.odo, GaitReckoning):
-            self.odo.advance(self.now)
+        if isinstance(self.odo, GaitReckoning):     # CHOICE: no motion counted while a foot has no ground
+            self.odo.advance(self.now)              # (tuning NP3_DR_FOOTLESS_GRIP: the body hardly turns then)
             self.odo.footless = error == _NO_GROUND
 
     def mark_pit(self, fx: float, fy: float) -> None:
         """seed 1.2.2 / 3.3.2: a foot found no ground at (fx, fy) (body frame): the pit's edge joins the map.
 
-        CHOICE: as a stretch NP3_PIT_EDGE_DEEP_M deep from the foot on, across the way the foot went (ahead of a front
-        foot, behind a rear one, beside a middle one): a front or rear foot's from the body's axis out to
+        CHOICE: as a stretch NP3_PIT_EDGE_DEEP_M deep from the foot on, across the way the foot went (ahead of a
+        front foot, behind a rear one, beside a middle one): a front or rear foot's from the body's axis out to
         NP3_PIT_EDGE_OUT_M beyond the foot (the other side's foot stands on ground, so the edge does not cross
         the axis), a middle foot's NP3_PIT_EDGE_ALONG_M either way along the body (its neighbours on that side
         stand on ground). One cell per report left a ring of pits as scattered dots the sonar's free space
@@ -708,10 +708,10 @@ class NP3(Runtime, Np3Skeleton):
             across = [(fx, lo + k * step) for k in range(int(round((hi - lo) / step)) + 1)]
         else:                                   # a middle foot: the edge beside it
             nx, ny = 0.0, math.copysign(1.0, fy)
-            k = int(round(T.NP3_PIT_EDGE_ALONG_M / step))
-            across = [(fx + m * step, fy) for m in range(-k, k + 1)]
+            n = int(round(T.NP3_PIT_EDGE_ALONG_M / step))
+            across = [(fx + m * step, fy) for m in range(-n, n + 1)]
         self.pits_met += 1
-        for depth in (k * step for k in range(int(round(T.NP3_PIT_EDGE_DEEP_M / step)) + 1)):
+        for depth in (d * step for d in range(int(round(T.NP3_PIT_EDGE_DEEP_M / step)) + 1)):
             for bx, by in across:
                 wx, wy = self.at_body(bx + depth * nx, by + depth * ny)
                 g.mark_barrier(wx, wy)
@@ -725,10 +725,10 @@ class NP3(Runtime, Np3Skeleton):
         CHOICE: hemmed in = the feet found NP3_RING_PITS pit edges (the way the robot chose ended at a pit,
         and the next way again): it stops following the open rays the sonar sees over the holes and plans a
         way out. Measured, pit_ring seeds 1-10 at 120 s: with two edges facing 90 deg apart asked for, the
-        robot stood in the gap at 41 s (seed 5) and was sent back in by an open ray; any two: 8 of 10 out. The ring's middle is the mean of the
-        path walked till then: the robot walked only where the ground held, inside the ring (where it stood
-        when it found the second pit was no middle: in the gap, with a pit either side, the ring's inside lay
-        beyond those two)."""
+        robot stood in the gap at 41 s (seed 5) and was sent back in by an open ray; with any two, 8 of 10
+        left the ring. The ring's middle is the mean of the path walked till then: the robot walked only
+        where the ground held, inside the ring (where it stood when it found the second pit was no middle:
+        in the gap, with a pit either side, the ring's inside lay beyond those two)."""
         if self.ring is None and self.pits_met >= T.NP3_RING_PITS:
             path = self.map.path
             self.ring = RingOut(sum(p[0] for p in path) / len(path), sum(p[1] for p in path) / len(path), 0.0)

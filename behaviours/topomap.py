@@ -231,7 +231,8 @@ class HeadingVotes:
         return max(-self.max_step, min(self.max_step, self.gain * mid))
 
 
-def _pit_distance(g: OccupancyGrid, pits: Sequence[tuple[float, float]], reach_m: float) -> dict[tuple[int, int], float]:
+def _pit_distance(g: OccupancyGrid, pits: Sequence[tuple[float, float]],
+                 reach_m: float) -> dict[tuple[int, int], float]:
     """The distance (m) from each cell within `reach_m` of some pit point to the nearest one."""
     out: dict[tuple[int, int], float] = {}
     n = int(math.ceil(reach_m / g.res))
@@ -459,8 +460,9 @@ class TopoMap:
         than `radius_m` from `centre`, as waypoints (the straight stretches the robot's disc fits along, the
         goal last); None when the map leaves none (call rebuild() first, for the clearance).
 
-        Over grid cells, not the places graph: one place per `place_spacing_m` block (1 m for the NP3) cannot
-        stand in a 0.8 m gap, and an edge through it must then run straight from block to block. A cell is
+        Over grid cells, not the places graph: the goal is a region (anywhere beyond the radius), not a point,
+        and the cost is per cell (the wariness below); the graph's places stand `place_spacing_m` apart (1 m
+        for the NP3), and a 0.4 m long, 0.8 m wide gap gets no place of its own. A cell is
         passable where the robot's disc fits (clearance >= its radius), or within `start_m` of the start (it
         backed off from a pit: its own ground is free). CHOICE: a cell within `wary_m` of a pit cell found
         (`pits`) costs up to `wary_cost` times its length more, the most next to it: a pit's edge runs on
