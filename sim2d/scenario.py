@@ -110,6 +110,18 @@ class Contention:
 
 
 @dataclass(frozen=True)
+class NoteOrder:
+    """`expect.order`: the note `first` is written, and before any `then` note (or no `then` note at all).
+
+    Why: a claim such as "the sonar avoids the wall before anything comes within whisker reach" (sonar_first) is
+    about the order of events on the approach, not about a count over the whole run (a touch while walking along
+    the wall afterwards does not contradict it)."""
+
+    first: str
+    then: str
+
+
+@dataclass(frozen=True)
 class Expectations:
     post: str | None = None
     no_collision: bool = False
@@ -119,6 +131,7 @@ class Expectations:
     min_distance: float | None = None
     max_reaction: float | None = None   # seed 5.2: stimulus -> reaction within this many seconds
     stay_out: tuple[tuple[float, float], ...] | None = None           # the body centre never enters
+    order: "NoteOrder | None" = None                                 # one debug-port note before another
     metrics: dict[str, dict[str, Any]] | None = None                  # dotted metric path -> {min, max, eq}
 
 
@@ -500,6 +513,7 @@ def _build(v: dict[str, Any], shown: str) -> Scenario:
             min_clearance=_opt(exp.get("min_clearance")), never_moves=exp.get("never_moves", False),
             min_distance=_opt(exp.get("min_distance")), max_reaction=_opt(exp.get("max_reaction")),
             stay_out=_poly(exp["stay_out"]) if "stay_out" in exp else None,
+            order=NoteOrder(exp["order"]["first"], exp["order"]["then"]) if "order" in exp else None,
             metrics=metrics or None,
         ),
         operator=tuple(sorted((OperatorKeys(float(o["at"]), o["keys"]) for o in v.get("operator", [])),

@@ -3,7 +3,8 @@ from __future__ import annotations
 
 import pytest
 
-from sim2d.metrics import lookup, reactions
+from sim2d.metrics import check_expectations, lookup, reactions
+from sim2d.scenario import Expectations, NoteOrder
 
 FWD, BACK, LEFT = 1, 2, 4
 
@@ -50,3 +51,23 @@ def test_a_note_never_written_counts_zero_and_other_absent_metrics_are_none():
     m = {"notes": {"escape": {"count": 2, "first_s": 1.0}}, "nodes": {}}
     assert lookup(m, "notes.escape.count") == 2 and lookup(m, "notes.stimulus.count") == 0
     assert lookup(m, "notes.stimulus.first_s") is None and lookup(m, "nodes.NP3.map.routes") is None
+
+
+def _order_verdict(notes: dict[str, dict[str, float]]) -> tuple[bool, str]:
+    scenario = type("S", (), {"expect": Expectations(order=NoteOrder("escape", "stimulus"))})()
+    [(name, ok, detail)] = check_expectations(scenario, {"notes": notes})
+    assert name == "order"
+    return ok, detail
+
+
+def test_order_holds_when_the_first_note_comes_before_any_of_the_second_or_none_comes():
+    """sonar_first: the sonar's avoidance (escape) before any close-up stimulus; a touch later does not matter."""
+    assert _order_verdict({"escape": {"first_s": 13.0}, "stimulus": {"first_s": 20.4}})[0]
+    assert _order_verdict({"escape": {"first_s": 13.0}})[0]
+
+
+def test_order_fails_when_the_second_note_comes_first_or_the_first_never_does():
+    ok, detail = _order_verdict({"escape": {"first_s": 13.0}, "stimulus": {"first_s": 12.9}})
+    assert not ok and detail == "first escape at 13.0 s, first stimulus at 12.9 s"
+    assert not _order_verdict({"stimulus": {"first_s": 5.0}})[0]
+    assert not _order_verdict({})[0]
