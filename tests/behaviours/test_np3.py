@@ -117,6 +117,29 @@ def test_a_feeler_touch_leaves_both_its_wires_in_the_memory_the_motion_check_ste
     assert all(p[1] > 0 for p in pts)                       # the left feeler's only
 
 
+def test_a_touch_beside_a_wall_the_sonar_shows_is_the_outer_wire_and_steps_away_from_it(spec):
+    """docs/decisions.md D18: a straight wall always meets an outer wire's tip first (the feelers' points
+    furthest forward and out). With a wall alongside on the touched side in the sonar's memory (corridor_narrow:
+    0.5 m wide, the outer wire reaching 17.7 cm beside the axis) the touch is that wall: one point at the wire's
+    tip, none across the lane ahead (they read as a blocked way and avoidance turned the body across the
+    corridor), and the escape a sidestep away from it, no turn. Without the sonar's wall the same touch leaves
+    both wires' points (a post lower than the sonar head: the test above)."""
+    metres = quantizer(M.XmitDataUsrc, "distance")
+    rig = np3(spec, task="idle")
+    for k, head in enumerate((270, 285, 300)):                   # the right-hand wall 0.2 m beside the axis
+        rig.inject(0.5 + k / 10, MCP, data("USRC", metres.raw(0.2 / math.sin(math.radians(360 - head))), VALUE,
+                                            channel=head))
+    rig.inject(1.0, MCP, data("TPSC", int(TpscContact.OBJ_RIGHT)))
+    rig.run(1.01)
+    touch = [e for e in rig.node.echoes if not e.sonar]
+    pts = body_frame(tuple(e.point() for e in touch), (0.0, 0.0, 0.0))
+    tip = T.NP3_WHISKER_ARMS[0][-1]
+    assert [(round(bx, 4), round(by, 4)) for bx, by, _s, _a in pts] == [(tip.x, -tip.y)]
+    rig.run(3.0)
+    after = [m for t, m in moves(rig) if t >= 1.0]
+    assert after[0] == MovCmd.SIDESTEP_LEFT and MovCmd.TURN_LEFT not in after and MovCmd.TURN_RIGHT not in after
+
+
 def test_unreliable_ir_stops_the_robot_and_a_contact_cannot_restart_it(spec):
     rig = np3(spec)
     rig.inject(1.0, MCP, data("IRRC", int(RangeStatus.UNRELIABLE), STATUS))
