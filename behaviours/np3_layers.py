@@ -78,6 +78,8 @@ class Tuning:
     contact_corner_normal_deg: float = T.NP3_CONTACT_CORNER_NORMAL_DEG
     contact_near_m: float = T.NP3_CONTACT_NEAR_M
     contact_alongside_s: float = T.NP3_CONTACT_ALONGSIDE_S
+    contact_alongside_min_deg: float = T.NP3_CONTACT_ALONGSIDE_MIN_DEG
+    contact_wall_reach_m: float = T.NP3_CONTACT_WALL_REACH_M
     ir_range_m: float = IR_RANGE_M
     ir_beam_deg: float = T.NP3_IR_BEAM_DEG
     ir_contact_m: float = T.NP3_IR_CONTACT_M
@@ -276,16 +278,35 @@ def contact_plan(i: Mapping[str, Any], left: bool, right: bool, t: Tuning, along
     outer wire (IR clear): a sidestep away from it, no turn (D18, CHOICE: in a corridor 4 cm wider than the
     feet's reach a turn away from one wall faced the body at the other; corridor_narrow)."""
     ir = _seen(i.get("ir"))
+    pose = i.get("pose")
+    beside = body_frame(i.get("echoes"), pose) if pose is not None else []
     if alongside and left != right and not any(d is not None for d in ir):
-        return [(t.contact_alongside_s, SIDE_RIGHT if left else SIDE_LEFT)]
+        side = 1.0 if left else -1.0
+        steps: Steps = [(t.contact_alongside_s, SIDE_RIGHT if left else SIDE_LEFT)]
+        closing = wall_closing_deg(beside, side, t)
+        if closing is not None and closing >= t.contact_alongside_min_deg:     # then parallel to it again
+            steps.append((min(closing, t.contact_min_turn_deg) / t.turn_rate_deg_s, RIGHT if left else LEFT))
+        return steps
     if left != right:
         obj_left = left                        # seed 3.2.12: OBJ_LEFT -> turn right
     else:                                      # the nearer side beam says where the object is
         obj_left = (ir[0] or math.inf) < (ir[-1] or math.inf)
-    pose = i.get("pose")
-    beside = body_frame(i.get("echoes"), pose) if pose is not None else []
     surfaces = sensed_surfaces(ir, 0.0 if left == right else (1.0 if left else -1.0), beside, t)
     return contact_steps(surfaces, -1.0 if obj_left else 1.0, t)    # square on: away from the touched side
+
+
+def wall_closing_deg(points: list[Point], side: float, t: Tuning) -> float | None:
+    """How far (deg) the wall alongside on `side` (+1 left) closes in on the heading ahead: the line fitted
+    through the remembered echoes beside the body there (within contact_wall_reach_m of the axis, from the rear
+    to avoid_echo_m ahead); None while fewer than 3 or spanning less than the body's half length."""
+    pts = [(bx, by * side) for bx, by, _s, _a in points
+           if t.body_half_width_m < by * side < t.contact_wall_reach_m and -t.body_half_length_m <= bx <= t.avoid_echo_m]
+    if len(pts) < 3 or max(b for b, _ in pts) - min(b for b, _ in pts) < t.body_half_length_m:
+        return None
+    n = len(pts)
+    mb, md = sum(b for b, _ in pts) / n, sum(d for _, d in pts) / n
+    slope = sum((b - mb) * (d - md) for b, d in pts) / sum((b - mb) ** 2 for b, _ in pts)
+    return -math.degrees(math.atan(slope))         # > 0: nearer ahead than behind
 
 
 def contact_trigger(t: Tuning) -> Trigger:
