@@ -194,7 +194,8 @@ NP3_SONAR_CARVE_TOL_M = 0.06  # ... and nearer than its own echo by this much (n
 NP3_BODY_FRONT_M = 0.15       # sensor mounts as the NP3 knows them: IR and whiskers at the body's front (CHOICE),
 NP3_IR_BEAM_DEG = 15.0        # ... the IR side beams at +-15 deg (seed 3.2.13),
 NP3_WHISKER_ARMS = (          # ... and the left feeler's wires (the right one's mirrored), from its root at the
-    (BodyPoint(0.15, 0.08), BodyPoint(0.2016, 0.1771)),                  # front corner: 11 cm 62 deg outward ...
+    (BodyPoint(0.15, 0.08), BodyPoint(0.2406, 0.1223)),                  # front corner: 10 cm 25 deg outward,
+    (BodyPoint(0.15, 0.08), BodyPoint(0.2016, 0.1771)),                  # ... 11 cm 62 deg outward (beside) ...
     (BodyPoint(0.15, 0.08), BodyPoint(0.195, 0.08), BodyPoint(0.195, 0.015)),  # ... and bent across the lane ahead
 )                             # (seed 1.2.2, CHOICE: sim2d.robot_params.whisker_arms, docs/decisions.md D18)
 NP3_WALL_TARGET_M = 0.30      # wall following: body centre to the right-hand wall (feet reach 0.2 m sideways) ...

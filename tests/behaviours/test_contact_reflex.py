@@ -168,3 +168,16 @@ def test_a_wall_alongside_that_touched_an_outer_wire_is_stepped_away_from_not_tu
     assert [cmd for _d, cmd in steps] == [MovCmd.SIDESTEP_LEFT]
     worst, heading = follow(steps, walls)
     assert worst < -0.08 and heading == 0.0
+
+
+def test_a_wall_alongside_closing_in_ahead_is_stepped_from_then_walked_parallel_to():
+    """The same touch with the wall 10 deg across the heading (the body yawed towards it: a sidestep alone
+    met it again and again, corridor_narrow seed 2): after the sidestep the escape turns away until the heading
+    is parallel to the wall the remembered echoes show, so walking on keeps the distance."""
+    walls = walls_at((-80.0,), 0.09)                    # a wall on the right, nearer ahead than behind
+    seen = sensed(walls)
+    assert seen["whisker"][1:3] == (False, True) and seen["ir"] == (None, None, None)
+    steps = contact_trigger(TUNING)({**seen, "whisker": WhiskerEvent(1, False, True, 0.0, alongside=True)}, 0.0)
+    assert [cmd for _d, cmd in steps] == [MovCmd.SIDESTEP_LEFT, MovCmd.TURN_LEFT]
+    worst, heading = follow(steps, walls)
+    assert worst < -0.08 and math.degrees(heading) == pytest.approx(10.0, abs=3.0)
