@@ -86,7 +86,7 @@ NP3_CONTACT_NEAR_M = 0.1      # ... a remembered echo beside the body this close
 NP3_CONTACT_WALL_BEYOND_M = 0.12  # a single whisker, IR clear, a sonar echo beside the body at most this further
 NP3_CONTACT_WALL_ALONG_M = 0.3    # ... out than the outer wire's tip and this near it along the axis: a wall
                               # alongside touched that wire's tip (D18): one point there, none in the lane, and ...
-NP3_CONTACT_ALONGSIDE_S = 0.4 # ... the escape a sidestep away this long (3.3 cm: the tip off the wall), no 60 deg
+NP3_CONTACT_ALONGSIDE_S = 0.6 # ... the escape a sidestep away this long (5 cm: the tip off the wall), no 60 deg
                               # guess's turn (from a wall of a 0.5 m corridor it faced the body at the other one);
 NP3_CONTACT_ALONGSIDE_MIN_DEG = 3.0  # ... then a turn parallel to the wall if it closes in ahead by this much or more
 NP3_CONTACT_WALL_REACH_M = 0.35      # ... (the line through the remembered echoes this near the axis on that side)
