@@ -34,7 +34,7 @@ from arachnae_proto.skeletons.np3 import Np3Skeleton
 
 from behaviours import tuning as T
 from behaviours.gait import FIVE_LEGGED, STILL, Gait
-from behaviours.geometry import RobotGeometry, along, mirrored
+from behaviours.geometry import FeelerArm, RobotGeometry, along, mirrored
 from behaviours.np3_layers import (AVOIDANCE, REFLEXES, PinnedCheck, TaskModule, Tuning, body_frame, closing_in,
                                    np3_network, safe_instead, steepness_deg, uphill)
 from behaviours.runtime import Runtime
@@ -615,11 +615,16 @@ class NP3(Runtime, Np3Skeleton):
         elif role == "TPSC" and v:
             left = bool(v & (TpscContact.OBJ_LEFT | TpscContact.OBJ_BOTH))
             right = bool(v & (TpscContact.OBJ_RIGHT | TpscContact.OBJ_BOTH))
-            self.bump("whisker", left, right, self.now)                 # seed 3.2.12
+            feeler = T.NP3_WHISKER_ARMS if left else mirrored(T.NP3_WHISKER_ARMS)
+            side_wire = max(feeler, key=lambda arm: abs(arm[-1].y))     # the wire reaching furthest out
+            alongside = left != right and self.ir == [None, None, None] and self.wall_alongside(side_wire)
+            self.bump("whisker", left, right, self.now, alongside)      # seed 3.2.12
             self.stopped_by_reflex(msg.address)
             for arms, hit in ((T.NP3_WHISKER_ARMS, left), (mirrored(T.NP3_WHISKER_ARMS), right)):
-                for arm in arms if hit else ():        # the touch: anywhere on the feeler's wires, so points
-                    for pt in (along(arm, k) for k in (0.2, 0.5, 0.85)):     # near each root, middle and tip
+                # the touch: anywhere on the feeler's wires, so points near each root, middle and tip; a wall
+                # alongside touches the side wire's tip (the point furthest out), nothing in the legs' way (D18)
+                for arm in ((side_wire,) if alongside else arms) if hit else ():
+                    for pt in (along(arm, k) for k in ((1.0,) if alongside else (0.2, 0.5, 0.85))):
                         self.echo(pt.x, pt.y, 0.0, 0.0)
         elif role == "IRRC" and 0 <= ch < 3:                            # seed 3.2.13: beam 0 left, 1 centre, 2 right
             self.ir[ch] = None if v >= _Q["IRRC"].hi else decode(role, v) / 100
@@ -647,6 +652,24 @@ class NP3(Runtime, Np3Skeleton):
             urgent = False
         if urgent and self.running:
             self.tick()                                                 # 5.2: react now, not next period
+
+    def wall_alongside(self, wire: FeelerArm) -> bool:
+        """A single-switch touch (IR beams clear) is a wall alongside that met this side wire, not the lane
+        wire, when the sonar's echo memory shows a surface beside the body on its side: at most
+        NP3_CONTACT_WALL_BEYOND_M further out than the wire's tip and within NP3_CONTACT_WALL_ALONG_M of it
+        along the axis (D18, CHOICE: the switch does not say which wire; a wall along the way meets the side
+        wire's tip first, the feelers' point furthest out). Why: the lane wire's points read as a blocked way
+        ahead, and the 60 deg guess turned the body from one wall of corridor_narrow (0.5 m wide, the side wire
+        reaching 17.7 cm beside the axis) to face the other. Only sonar echoes count (a touch's own points lie
+        on the wires), and the posts the feelers are for are lower than the sonar head: a post met leaves all
+        the wires' points. The band is wide because the memory's walls are where the dead-reckoned
+        heading put them (10-25 deg off in corridor_narrow; 5 cm round the wire found 14 of 32 touches on seeds 3
+        and 12, and 7 of seeds 1-20 passed)."""
+        pts = body_frame(tuple(e.point() for e in self.echoes if e.sonar), self.pose_at(None))
+        tip = wire[-1]
+        side = 1.0 if tip.y > 0 else -1.0
+        return any(self.tuning.body_half_width_m < by * side < abs(tip.y) + T.NP3_CONTACT_WALL_BEYOND_M
+                   and abs(bx - tip.x) < T.NP3_CONTACT_WALL_ALONG_M for bx, by, _s, _a in pts)
 
     def stopped_by_reflex(self, source: int) -> None:
         """spec reflexes (seed 5.2): the MCP stopped the legs when this record passed it; what we sent last no

@@ -38,7 +38,7 @@ Steps = list[tuple[float, Any]]
 Trigger = Callable[[Mapping[str, Any], float], "Steps | None"]
 
 # Sensor registers of the network (set by the node with net.sense(...)):
-#   whisker (seq, l, r, time)    a TPSC contact event      ir (left, centre, right) m, None = nothing in range
+#   whisker WhiskerEvent         a TPSC contact event      ir (left, centre, right) m, None = nothing in range
 #   ir_fault bool                IRRC unreliable / failed   pit int                 count of MMC NO_GROUND reports
 #   tilt (lon, transverse) deg   ISC                        battery_low bool        latched PSC alarm / low value
 #   leg_blocked (seq, side)      blocked report, +1 left    sonar_ahead_m m | None  a fresh sonar echo ahead
@@ -77,6 +77,9 @@ class Tuning:
     contact_corner_m: float = T.NP3_CONTACT_CORNER_M
     contact_corner_normal_deg: float = T.NP3_CONTACT_CORNER_NORMAL_DEG
     contact_near_m: float = T.NP3_CONTACT_NEAR_M
+    contact_alongside_s: float = T.NP3_CONTACT_ALONGSIDE_S
+    contact_alongside_min_deg: float = T.NP3_CONTACT_ALONGSIDE_MIN_DEG
+    contact_wall_reach_m: float = T.NP3_CONTACT_WALL_REACH_M
     ir_range_m: float = IR_RANGE_M
     ir_beam_deg: float = T.NP3_IR_BEAM_DEG
     ir_contact_m: float = T.NP3_IR_CONTACT_M
@@ -260,18 +263,50 @@ def contact_steps(surfaces: list[Surface], prefer: float, t: Tuning) -> Steps:
     return steps
 
 
-def contact_plan(i: Mapping[str, Any], left: bool, right: bool, t: Tuning) -> Steps:
+class WhiskerEvent(NamedTuple):
+    """The whisker register: a TPSC contact (seed 3.2.12) as the node read it."""
+    seq: int
+    left: bool
+    right: bool
+    at: float                  # when it arrived
+    alongside: bool = False    # one switch, IR clear, the sonar shows a wall at that outer wire (np3.NP3.wall_alongside)
+
+
+def contact_plan(i: Mapping[str, Any], left: bool, right: bool, t: Tuning, alongside: bool = False) -> Steps:
     """The escape from what touches the body now: the IR beams' surfaces (or the whisker's guess) and the
-    remembered echoes beside the body, in the body frame of the pose now."""
+    remembered echoes beside the body, in the body frame of the pose now. A wall alongside that touched one
+    outer wire (IR clear): a sidestep away from it, no turn (D18, CHOICE: in a corridor 4 cm wider than the
+    feet's reach a turn away from one wall faced the body at the other; corridor_narrow)."""
     ir = _seen(i.get("ir"))
+    pose = i.get("pose")
+    beside = body_frame(i.get("echoes"), pose) if pose is not None else []
+    if alongside and left != right and not any(d is not None for d in ir):
+        side = 1.0 if left else -1.0
+        steps: Steps = [(t.contact_alongside_s, SIDE_RIGHT if left else SIDE_LEFT)]
+        closing = wall_closing_deg(beside, side, t)
+        if closing is not None and closing >= t.contact_alongside_min_deg:     # then parallel to it again
+            steps.append((min(closing, t.contact_min_turn_deg) / t.turn_rate_deg_s, RIGHT if left else LEFT))
+        return steps
     if left != right:
         obj_left = left                        # seed 3.2.12: OBJ_LEFT -> turn right
     else:                                      # the nearer side beam says where the object is
         obj_left = (ir[0] or math.inf) < (ir[-1] or math.inf)
-    pose = i.get("pose")
-    beside = body_frame(i.get("echoes"), pose) if pose is not None else []
     surfaces = sensed_surfaces(ir, 0.0 if left == right else (1.0 if left else -1.0), beside, t)
     return contact_steps(surfaces, -1.0 if obj_left else 1.0, t)    # square on: away from the touched side
+
+
+def wall_closing_deg(points: list[Point], side: float, t: Tuning) -> float | None:
+    """How far (deg) the wall alongside on `side` (+1 left) closes in on the heading ahead: the line fitted
+    through the remembered echoes beside the body there (within contact_wall_reach_m of the axis, from the rear
+    to avoid_echo_m ahead); None while fewer than 3 or spanning less than the body's half length."""
+    pts = [(bx, by * side) for bx, by, _s, _a in points
+           if t.body_half_width_m < by * side < t.contact_wall_reach_m and -t.body_half_length_m <= bx <= t.avoid_echo_m]
+    if len(pts) < 3 or max(b for b, _ in pts) - min(b for b, _ in pts) < t.body_half_length_m:
+        return None
+    n = len(pts)
+    mb, md = sum(b for b, _ in pts) / n, sum(d for _, d in pts) / n
+    slope = sum((b - mb) * (d - md) for b, d in pts) / sum((b - mb) ** 2 for b, _ in pts)
+    return -math.degrees(math.atan(slope))         # > 0: nearer ahead than behind
 
 
 def contact_trigger(t: Tuning) -> Trigger:
@@ -280,13 +315,14 @@ def contact_trigger(t: Tuning) -> Trigger:
     edge = _Edge()
 
     def trigger(i: Mapping[str, Any], now: float) -> Steps | None:
-        w = i.get("whisker")               # (seq, left, right, time): a touch older than one hold is history
-        touched = edge.new(w) and now - w[3] <= t.reflex_hold_s
-        left, right = (w[1], w[2]) if touched else (False, False)
+        raw = i.get("whisker")
+        w = WhiskerEvent(*raw) if raw is not None else None     # a touch older than one hold is history
+        touched = w is not None and edge.new(raw) and now - w.at <= t.reflex_hold_s
+        left, right = (w.left, w.right) if touched and w is not None else (False, False)
         close = [d is not None and d < t.ir_contact_m for d in _seen(i.get("ir"))]
         if not (touched or any(close)):
             return None
-        return contact_plan(i, left, right, t)
+        return contact_plan(i, left, right, t, alongside=touched and w is not None and w.alongside)
     return trigger
 
 
@@ -316,8 +352,9 @@ class ContactModule(ReflexModule):
         out = super().step(inputs, now)
         seen = any(d is not None for d in _seen(inputs.get("ir")))
         if self.plan is not None and self.plan is not before:          # a new escape
-            w = inputs.get("whisker")
-            self.guess = Touch(now, bool(w[1]), bool(w[2])) if w and not seen else None
+            raw = inputs.get("whisker")
+            w = WhiskerEvent(*raw) if raw else None
+            self.guess = Touch(now, bool(w.left), bool(w.right)) if w is not None and not seen else None
         elif self.plan is not None and self.guess is not None and seen:
             if now - self.guess.at <= self.t.reflex_hold_s:
                 self.plan = Plan(contact_plan(inputs, self.guess.left, self.guess.right, self.t), now)
@@ -992,6 +1029,6 @@ def np3_network(clock: Clock, task: str = "forward", tuning: Tuning | None = Non
     return net
 
 
-__all__ = ["uphill", "steepness_deg", "Tuning", "TaskModule", "OrientModule", "np3_network", "light_gradient", "heading_error", "SENSORS",
+__all__ = ["WhiskerEvent", "uphill", "steepness_deg", "Tuning", "TaskModule", "OrientModule", "np3_network", "light_gradient", "heading_error", "SENSORS",
            "closing_in", "safe_instead", "body_frame", "PinnedCheck",
            "REFLEXES", "AVOIDANCE", "TASK", "TASKS"]

@@ -83,6 +83,13 @@ NP3_CONTACT_WHISKER_NORMAL_DEG = 60.0  # a whisker alone (IR beams clear): the s
 NP3_CONTACT_CORNER_M = 0.01   # the IR centre point this far behind the line through the side points: a corner;
 NP3_CONTACT_CORNER_NORMAL_DEG = 45.0  # ... the side beams alone see a corner: its walls taken to face this far aside
 NP3_CONTACT_NEAR_M = 0.1      # ... a remembered echo beside the body this close to it: a wall alongside
+NP3_CONTACT_WALL_BEYOND_M = 0.12  # a single whisker, IR clear, a sonar echo beside the body at most this further
+NP3_CONTACT_WALL_ALONG_M = 0.3    # ... out than the outer wire's tip and this near it along the axis: a wall
+                              # alongside touched that wire's tip (D18): one point there, none in the lane, and ...
+NP3_CONTACT_ALONGSIDE_S = 0.6 # ... the escape a sidestep away this long (5 cm: the tip off the wall), no 60 deg
+                              # guess's turn (from a wall of a 0.5 m corridor it faced the body at the other one);
+NP3_CONTACT_ALONGSIDE_MIN_DEG = 3.0  # ... then a turn parallel to the wall if it closes in ahead by this much or more
+NP3_CONTACT_WALL_REACH_M = 0.35      # ... (the line through the remembered echoes this near the axis on that side)
 NP3_IR_CONTACT_M = 0.03       # an IR echo this close counts as contact
 NP3_AVOID_CENTRE_M = 0.08     # avoidance: the centre beam sees something this close ...
 NP3_AVOID_SIDE_M = 0.06       # ... or a side beam this close -> turn away
@@ -200,7 +207,8 @@ NP3_SONAR_CARVE_TOL_M = 0.06  # ... and nearer than its own echo by this much (n
 NP3_BODY_FRONT_M = 0.15       # sensor mounts as the NP3 knows them: IR and whiskers at the body's front (CHOICE),
 NP3_IR_BEAM_DEG = 15.0        # ... the IR side beams at +-15 deg (seed 3.2.13),
 NP3_WHISKER_ARMS = (          # ... and the left feeler's wires (the right one's mirrored), from its root at the
-    (BodyPoint(0.15, 0.08), BodyPoint(0.2406, 0.1223)),                  # front corner: 10 cm 25 deg outward ...
+    (BodyPoint(0.15, 0.08), BodyPoint(0.2406, 0.1223)),                  # front corner: 10 cm 25 deg outward,
+    (BodyPoint(0.15, 0.08), BodyPoint(0.2016, 0.1771)),                  # ... 11 cm 62 deg outward (beside) ...
     (BodyPoint(0.15, 0.08), BodyPoint(0.195, 0.08), BodyPoint(0.195, 0.015)),  # ... and bent across the lane ahead
 )                             # (seed 1.2.2, CHOICE: sim2d.robot_params.whisker_arms, docs/decisions.md D18)
 NP3_WALL_TARGET_M = 0.30      # wall following: body centre to the right-hand wall (feet reach 0.2 m sideways) ...

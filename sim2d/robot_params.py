@@ -34,14 +34,20 @@ class RobotParams(RobotGeometry):
     battery_r_ohm: float = 0.05           # CHOICE: internal resistance
     # seed 1.2.2: rigid feelers for the near field "bis zu 10 cm", one end switch per side (3.2.12). CHOICE (their
     # shape is not given; docs/decisions.md D18): the left feeler, rooted at the body's front corner, is a fork
-    # of two wires, each at most 11 cm long. The outer arm, straight, 10 cm at 25 deg outward, sweeps 8-12.2 cm
-    # beside the axis (what a turn on the spot sweeps the corner into); the inner arm runs 4.5 cm forward along
+    # of three wires, each at most 11 cm long. The outer arm, straight, 10 cm at 25 deg outward, sweeps 8-12.2 cm
+    # beside the axis up to 9 cm ahead of the face (a post there is felt while the body can still turn off it:
+    # posts_turn); the side arm, straight, 11 cm at 62 deg outward, sweeps 8-17.7 cm: a turn on the spot sweeps
+    # the body's sides out to its corners' circle (17 cm round the centre), so a post walked past closer than
+    # that is met by the next turn (posts_field seed 11 without it: a post 15 cm out, 17 contacts); the inner
+    # arm runs 4.5 cm forward along
     # the side line, then bends inward across the body's lane to 1.5 cm beside the axis, 4.5 cm ahead of the
     # front face: a thin post there is touched with room to stop (the TPSC's STOP takes 3.3 cm). The right
     # feeler is its mirror image (geometry.mirrored).
     whisker_arms: tuple[FeelerArm, ...] = (
         (BodyPoint(0.15, 0.08), BodyPoint(0.15 + 0.10 * math.cos(math.radians(25)),
                                           0.08 + 0.10 * math.sin(math.radians(25)))),
+        (BodyPoint(0.15, 0.08), BodyPoint(0.15 + 0.11 * math.cos(math.radians(62)),
+                                          0.08 + 0.11 * math.sin(math.radians(62)))),
         (BodyPoint(0.15, 0.08), BodyPoint(0.195, 0.08), BodyPoint(0.195, 0.015)),
     )
     ir_range: float = 0.10                # seed 3.2.13: "bis etwa 10 cm"

@@ -11,7 +11,8 @@ from typing import NamedTuple
 
 import pytest
 
-from behaviours.np3_layers import ContactModule, Tuning, contact_trigger, velocity
+from arachnae_proto.enums import MovCmd
+from behaviours.np3_layers import ContactModule, Tuning, WhiskerEvent, contact_trigger, velocity
 from behaviours import tuning as T
 from behaviours.geometry import mirrored
 from sim2d.robot_params import DEFAULT as P
@@ -119,7 +120,7 @@ def test_a_touch_the_ir_reports_a_poll_later_is_escaped_from_what_the_beams_see(
     arrives while the beams still read nothing (clutter seed 3). The guess (the surface 60 deg aside) turns
     only 50 deg without backing off and leaves the face ahead of the robot's side; once the beams report
     (0.2 s later) the escape is planned again from them: back off, turn until the face is behind the side."""
-    walls = walls_at((-10.0,), 0.07)
+    walls = walls_at((-10.0,), 0.06)                   # the right outer wire's tip reaches 6.8 cm past the corner
     seen = sensed(walls)
     assert seen["whisker"][1:3] == (False, True) and seen["ir"][1] is not None     # the case: right whisker, IR ahead
     blind = {**seen, "ir": (None, None, None)}
@@ -144,7 +145,7 @@ def test_a_touch_the_ir_reports_a_poll_later_is_escaped_from_what_the_beams_see(
 def test_a_touch_the_ir_reports_after_the_hold_keeps_its_escape():
     """Only the beams' report of the touch itself re-plans: an echo more than one reflex hold later is
     something the escape has turned to since, and the escape runs on."""
-    walls = walls_at((-10.0,), 0.07)
+    walls = walls_at((-10.0,), 0.06)
     seen = sensed(walls)
     blind = {**seen, "ir": (None, None, None)}
     reflex = ContactModule(TUNING)
@@ -152,3 +153,31 @@ def test_a_touch_the_ir_reports_after_the_hold_keeps_its_escape():
     plan = reflex.plan
     reflex.step(seen, TUNING.reflex_hold_s + 0.1)
     assert reflex.plan is plan
+
+
+def test_a_wall_alongside_that_touched_an_outer_wire_is_stepped_away_from_not_turned_from():
+    """docs/decisions.md D18 (corridor_narrow): the node found a wall alongside where the right outer wire
+    reaches (sonar memory, IR clear: WhiskerEvent.alongside). Turning from it on the 60 deg guess faced the body
+    at the corridor's other wall; the escape is a sidestep away, the heading kept, no corner into the wall."""
+    walls = walls_at((-90.0,), 0.09)                    # the right outer wire's tip reaches 9.7 cm past the side
+    seen = sensed(walls)
+    assert seen["whisker"][1:3] == (False, True) and seen["ir"] == (None, None, None)
+    guessed = contact_trigger(TUNING)(seen, 0.0)
+    assert any(cmd in (MovCmd.TURN_LEFT, MovCmd.TURN_RIGHT) for _d, cmd in guessed)   # not known: the guess
+    steps = contact_trigger(TUNING)({**seen, "whisker": WhiskerEvent(1, False, True, 0.0, alongside=True)}, 0.0)
+    assert [cmd for _d, cmd in steps] == [MovCmd.SIDESTEP_LEFT]
+    worst, heading = follow(steps, walls)
+    assert worst < -0.08 and heading == 0.0
+
+
+def test_a_wall_alongside_closing_in_ahead_is_stepped_from_then_walked_parallel_to():
+    """The same touch with the wall 10 deg across the heading (the body yawed towards it: a sidestep alone
+    met it again and again, corridor_narrow seed 2): after the sidestep the escape turns away until the heading
+    is parallel to the wall the remembered echoes show, so walking on keeps the distance."""
+    walls = walls_at((-80.0,), 0.09)                    # a wall on the right, nearer ahead than behind
+    seen = sensed(walls)
+    assert seen["whisker"][1:3] == (False, True) and seen["ir"] == (None, None, None)
+    steps = contact_trigger(TUNING)({**seen, "whisker": WhiskerEvent(1, False, True, 0.0, alongside=True)}, 0.0)
+    assert [cmd for _d, cmd in steps] == [MovCmd.SIDESTEP_LEFT, MovCmd.TURN_LEFT]
+    worst, heading = follow(steps, walls)
+    assert worst < -0.08 and math.degrees(heading) == pytest.approx(10.0, abs=3.0)

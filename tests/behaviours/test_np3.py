@@ -101,10 +101,10 @@ def test_left_whisker_turns_right_without_backing_off(spec):
     assert after[:2] == [MovCmd.SIDESTEP_RIGHT, MovCmd.TURN_RIGHT]
 
 
-def test_a_feeler_touch_leaves_both_its_wires_in_the_memory_the_motion_check_steers_by(spec):
+def test_a_feeler_touch_leaves_all_its_wires_in_the_memory_the_motion_check_steers_by(spec):
     """docs/decisions.md D18: the left switch says only that a wire of the left feeler touched something, so the
-    local memory gets points near the root, middle and tip of both wires: beside the front corner (the outer
-    wire) and across the body's lane ahead of the face (the inner wire). A thin post met by the inner wire is
+    local memory gets points near the root, middle and tip of every wire: beside the front corner (the outer
+    and the side wire) and across the body's lane ahead of the face (the inner wire). A thin post met by the inner wire is
     then in the memory where the turn away would sweep the face into it (posts_low)."""
     rig = np3(spec, task="idle")
     rig.inject(1.0, MCP, data("TPSC", int(TpscContact.OBJ_LEFT)))
@@ -113,8 +113,31 @@ def test_a_feeler_touch_leaves_both_its_wires_in_the_memory_the_motion_check_ste
     half_w = DEFAULT_GEOMETRY.body_width / 2
     lane = [p for p in pts if p[0] > T.NP3_BODY_FRONT_M + 0.035 and 0.0 < p[1] < half_w]
     beside = [p for p in pts if p[1] > half_w]
-    assert len(lane) >= 2 and len(beside) == 3, pts
+    assert len(lane) >= 2 and len(beside) == 6, pts         # the outer and the side wire's
     assert all(p[1] > 0 for p in pts)                       # the left feeler's only
+
+
+def test_a_touch_beside_a_wall_the_sonar_shows_is_the_side_wire_and_steps_away_from_it(spec):
+    """docs/decisions.md D18: a wall along the way meets the side wire's tip first (the feelers' point
+    furthest out). With a wall alongside on the touched side in the sonar's memory (corridor_narrow:
+    0.5 m wide, the side wire reaching 17.7 cm beside the axis) the touch is that wall: one point at the wire's
+    tip, none across the lane ahead (they read as a blocked way and avoidance turned the body across the
+    corridor), and the escape a sidestep away from it, no turn. Without the sonar's wall the same touch leaves
+    both wires' points (a post lower than the sonar head: the test above)."""
+    metres = quantizer(M.XmitDataUsrc, "distance")
+    rig = np3(spec, task="idle")
+    for k, head in enumerate((270, 285, 300)):                   # the right-hand wall 0.2 m beside the axis
+        rig.inject(0.5 + k / 10, MCP, data("USRC", metres.raw(0.2 / math.sin(math.radians(360 - head))), VALUE,
+                                            channel=head))
+    rig.inject(1.0, MCP, data("TPSC", int(TpscContact.OBJ_RIGHT)))
+    rig.run(1.01)
+    touch = [e for e in rig.node.echoes if not e.sonar]
+    pts = body_frame(tuple(e.point() for e in touch), (0.0, 0.0, 0.0))
+    tip = T.NP3_WHISKER_ARMS[1][-1]                              # the side wire's, 17.7 cm beside the axis
+    assert [(round(bx, 4), round(by, 4)) for bx, by, _s, _a in pts] == [(tip.x, -tip.y)]
+    rig.run(3.0)
+    after = [m for t, m in moves(rig) if t >= 1.0]
+    assert after[0] == MovCmd.SIDESTEP_LEFT and MovCmd.TURN_LEFT not in after and MovCmd.TURN_RIGHT not in after
 
 
 def test_unreliable_ir_stops_the_robot_and_a_contact_cannot_restart_it(spec):

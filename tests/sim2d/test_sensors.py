@@ -86,6 +86,45 @@ def test_the_feelers_sense_every_thin_post_in_the_body_lane(write, spec, width, 
         assert blind == [], f"posts with their inner edge this far left of the axis (m) are not sensed: {blind}"
 
 
+WITHOUT_SIDE_WIRE = replace(P, whisker_arms=(P.whisker_arms[0], P.whisker_arms[2]))   # D18 before: two wires
+
+
+@pytest.mark.parametrize("width", [0.02, 0.03])
+@pytest.mark.parametrize("params, blind_ok", [(P, False), (WITHOUT_SIDE_WIRE, True)], ids=["feelers", "no-side-wire"])
+def test_the_feelers_sense_every_thin_post_beside_the_body_a_turn_on_the_spot_sweeps(write, spec, width, params,
+                                                                                       blind_ok):
+    """docs/decisions.md D18 (scenarios/open/posts_field.yaml seed 11): a turn on the spot sweeps the body's
+    sides out to its corners' circle (17 cm round the centre), so a post walked past beside the body closer to
+    the axis than that is met by the next turn. Walking straight past a post 12 cm tall (below the sonar head)
+    whose inner edge lies 8-17 cm beside the axis (5 mm steps, either side), a feeler touches it before the
+    front face has passed it. Without the side wire (62 deg) the outer wire at 25 deg reached 12.2 cm: posts
+    12.5-17 cm out were never felt (posts_field seed 11: walked past 15 cm out, the explore task's turn met
+    it, 17 contacts)."""
+    half_w, front = P.body_width / 2, P.body_length / 2
+    corner = math.hypot(front, half_w)
+    blind = []
+    for side in (1.0, -1.0):
+        for k in range(int(round((corner - half_w) / 0.005)) + 1):
+            inner = half_w + 0.005 * k
+            y0 = 2.0 + inner if side > 0 else 2.0 - inner - width
+            x0 = 1.0 + front + 0.12
+            post = f"obstacles: [{{polygon: [[{x0}, {y0}], [{x0 + width}, {y0}], [{x0 + width}, {y0 + width}], " \
+                   f"[{x0}, {y0 + width}]], height: 0.12}}]\n"
+            s = sensors(write, post, params=params)
+            steps = int(round((0.12 + width) / 0.005)) + 1          # until the face is level with its far side
+            if not any(_touched(s, 1.0 + 0.005 * step) for step in range(steps)):
+                blind.append(round(side * inner, 4))
+    if blind_ok:
+        assert len(blind) >= 10, f"without the side wire only {blind} are blind"
+    else:
+        assert blind == [], f"posts with their inner edge this far beside the axis (m, + left) are not felt: {blind}"
+
+
+def _touched(s: Sensors, x: float) -> bool:
+    s.robot.pose = (x, 2.0, 0.0)
+    return any(s.whiskers())
+
+
 def test_light_falls_with_distance_and_is_shaded_by_walls(write, spec):
     lit = "lights: [{pos: [2, 2], intensity: 990}]\n"          # 990 cd at 1 m + 10 lx ambient = 1000 lx
     assert sensors(write, lit).lsc() == pytest.approx(1000, rel=0.1)
