@@ -346,6 +346,7 @@ class NP3(Runtime, Np3Skeleton):
         self.heard: set[str] = set()          # roles that sent a record since power-on
         self.look_until = math.inf            # no step before the IR and whiskers reported, or until then (seed 5.2)
         self.tilt = [0.0, 0.0]
+        self.touch_at, self.touch_side = -math.inf, 0.0   # the last single-feeler touch: when, side (+1 left)
         self.seq = {"whisker": 0, "pit": 0, "leg_blocked": 0, "light": 0, "sound": 0, "veto": 0, "pinned": 0}
         self.pinned = PinnedCheck(self.tuning)        # issue 17: the body held by something no sensor sees
         self.escape_plans: dict[str, Any] = {}   # module -> its manoeuvre last noted as an escape window (5.2)
@@ -442,7 +443,8 @@ class NP3(Runtime, Np3Skeleton):
         pts = body_frame(tuple(e.point() for e in self.echoes), pose)
         if closing_in(pts, cmd, self.tuning) == 0.0:
             return False
-        self.bump("veto", safe_instead(pts, cmd, self.tuning))
+        fresh = self.now - self.touch_at <= T.NP3_TOUCH_FRESH_S
+        self.bump("veto", safe_instead(pts, cmd, self.tuning, self.touch_side if fresh else 0.0))
         return True
 
     def plan_goal(self, now: float) -> None:
@@ -619,6 +621,8 @@ class NP3(Runtime, Np3Skeleton):
             side_wire = max(feeler, key=lambda arm: abs(arm[-1].y))     # the wire reaching furthest out
             alongside = left != right and self.ir == [None, None, None] and self.wall_alongside(side_wire)
             self.bump("whisker", left, right, self.now, alongside)      # seed 3.2.12
+            if left != right:                                           # one feeler: the side the surface is on
+                self.touch_at, self.touch_side = self.now, 1.0 if left else -1.0
             self.stopped_by_reflex(msg.address)
             for arms, hit in ((T.NP3_WHISKER_ARMS, left), (mirrored(T.NP3_WHISKER_ARMS), right)):
                 # the touch: anywhere on the feeler's wires, so points near each root, middle and tip; a wall

@@ -506,7 +506,7 @@ def closing_in(points: list[Point], cmd: Any, t: Tuning) -> float:
     return worst
 
 
-def safe_instead(points: list[Point], cmd: Any, t: Tuning) -> Any:
+def safe_instead(points: list[Point], cmd: Any, t: Tuning, touched: float = 0.0) -> Any:
     """The command to give instead of an unsafe `cmd`: the closest safe alternative (turn the other way,
     turn towards the freer side, back off), STOP when nothing is safe. A turn refused whose other way turns
     towards the crowded side (a wall along one flank that also closes in ahead: the end swings into it one
@@ -517,7 +517,11 @@ def safe_instead(points: list[Point], cmd: Any, t: Tuning) -> Any:
     the right-hand wall 0.27 m ahead-right, the left-hand wall's echoes more numerous, the guard turned right);
     when that turn would swing the rear into what lies alongside, it sidesteps away from them instead of
     backing off (a corridor walked a few degrees off its axis: backing off and walking on met the same wall
-    again and again, corridor_narrow seeds 18 and 19)."""
+    again and again, corridor_narrow seeds 18 and 19).
+    `touched` (+1 left, -1 right, 0 none): a feeler on that side touched just now (NP3_TOUCH_FRESH_S); no
+    alternative sidesteps or turns towards it. The touch is where a surface is now, the remembered echoes are
+    where the drifting reckoning put them: a sidestep away from a wall touched, refused for an echo on the other
+    side, became a sidestep into the wall (corridor_narrow seed 20, fourteenth session)."""
     crowd = sum(1 if by > 0 else -1 for bx, by, _s, _a in points if abs(bx) < 0.4 and abs(by) < 0.4)
     if cmd in (FORWARD, BACKWARD):
         crowd = sum(1 if p[1] > 0 else -1 for p in points if closing_in([p], cmd, t) > 0) or crowd
@@ -528,8 +532,9 @@ def safe_instead(points: list[Point], cmd: Any, t: Tuning) -> Any:
                RIGHT: (LEFT, BACKWARD, FORWARD), SIDE_LEFT: (SIDE_RIGHT, *freer), SIDE_RIGHT: (SIDE_LEFT, *freer)}
     if crowd and cmd == freer[0]:                     # the other way is towards the crowded side
         options[cmd] = (away, *options[cmd])
+    towards = {1.0: (SIDE_LEFT, LEFT), -1.0: (SIDE_RIGHT, RIGHT)}.get(touched, ())
     for alt in options.get(cmd, ()):
-        if closing_in(points, alt, t) == 0.0:
+        if alt not in towards and closing_in(points, alt, t) == 0.0:
             return alt
     return STOP
 

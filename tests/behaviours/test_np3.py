@@ -781,3 +781,19 @@ def test_the_reckonings_turn_grip_is_the_running_gaits():
         assert bare.th > math.radians(30)
         turned[gait] = odo.th / bare.th
     assert turned == pytest.approx({g: T.NP3_DR_TURN_GRIP[g] for g in turned}, abs=1e-9)
+
+
+def test_a_refused_step_away_from_a_fresh_touch_never_steps_or_turns_into_it():
+    """corridor_narrow seed 20: the right feeler touched the wall alongside, the contact reflex's SIDESTEP_LEFT
+    was refused for a remembered echo off the left rear (placed by a heading 12 deg off), and the guard's
+    first alternative, SIDESTEP_RIGHT, walked the body into the wall it had just touched."""
+    from behaviours.np3_layers import closing_in, safe_instead
+    t = Tuning()
+    left_rear = [(-0.152, 0.202, 90.0, 0.0)]
+    assert closing_in(left_rear, MovCmd.SIDESTEP_LEFT, t) > 0
+    assert safe_instead(left_rear, MovCmd.SIDESTEP_LEFT, t) == MovCmd.SIDESTEP_RIGHT      # no touch known
+    instead = safe_instead(left_rear, MovCmd.SIDESTEP_LEFT, t, touched=-1.0)
+    assert instead not in (MovCmd.SIDESTEP_RIGHT, MovCmd.TURN_RIGHT) and closing_in(left_rear, instead, t) == 0
+    mirrored = [(-0.152, -0.202, -90.0, 0.0)]
+    assert safe_instead(mirrored, MovCmd.SIDESTEP_RIGHT, t, touched=1.0) not in (MovCmd.SIDESTEP_LEFT,
+                                                                               MovCmd.TURN_LEFT)
