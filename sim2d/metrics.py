@@ -350,7 +350,7 @@ def check_expectations(scenario: Any, m: dict[str, Any]) -> list[tuple[str, bool
         t = m["entered_forbidden_s"]
         out.append(("stay_out", t is None, "never entered the region" if t is None else f"entered the region at {t} s"))
     if e.order is not None:
-        first, then = (m["notes"].get(n, {}).get("first_s") for n in (e.order.first, e.order.then))
+        first, then = (lookup(m, f"notes.{n}.first_s") for n in (e.order.first, e.order.then))
         ok = first is not None and (then is None or first < then)
         out.append(("order", ok, f"first {e.order.first} at {first} s, first {e.order.then} at {then} s"))
     if "protocol.violations" not in (e.metrics or {}) and "protocol" in m:

@@ -131,7 +131,7 @@ class Expectations:
     min_distance: float | None = None
     max_reaction: float | None = None   # seed 5.2: stimulus -> reaction within this many seconds
     stay_out: tuple[tuple[float, float], ...] | None = None           # the body centre never enters
-    order: "NoteOrder | None" = None                                 # one debug-port note before another
+    order: NoteOrder | None = None                                   # one debug-port note before another
     metrics: dict[str, dict[str, Any]] | None = None                  # dotted metric path -> {min, max, eq}
 
 
